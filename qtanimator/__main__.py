@@ -1,0 +1,3 @@
+from qtanimator.cli import main
+
+raise SystemExit(main())

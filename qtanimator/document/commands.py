@@ -1,0 +1,377 @@
+"""Qt-free undoable commands.
+
+A command captures the old and new state of what it touches when it is built, so ``do``
+and ``undo`` are exact and can be repeated (redo). ``merge`` folds a later command of the
+same gesture into this one, so that one mouse drag is one undo step: commands built with
+the same ``gesture`` token (any hashable the widget picks at mouse press) merge.
+
+The ``ui`` package wraps each command in a QUndoCommand (``qtanimator.ui.undo``).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Hashable, Iterable, Sequence
+from typing import Any
+
+from qtanimator.core.channel import Channel, Extrapolation, Key, Tangent
+from qtanimator.document.document import Asset, Document
+
+
+class Command:
+    """Base class: subclasses implement ``do`` and ``undo``; ``text`` names the step."""
+
+    text: str = "Edit"
+    gesture: Hashable | None = None
+
+    def do(self, doc: Document) -> None:
+        raise NotImplementedError
+
+    def undo(self, doc: Document) -> None:
+        raise NotImplementedError
+
+    def merge(self, other: Command) -> bool:
+        """Absorb ``other`` (pushed right after this one). Return True if merged."""
+        return False
+
+    def is_noop(self) -> bool:
+        return False
+
+
+class SetChannels(Command):
+    """Replace whole channels: ``changes`` maps channel id to ``(old, new)``.
+
+    ``None`` as old means the channel is created, as new that it is removed. Every key
+    edit is one of these; the named subclasses below build ``changes`` from the document.
+    """
+
+    def __init__(self, text: str, changes: dict[str, tuple[Channel | None, Channel | None]],
+                 gesture: Hashable | None = None) -> None:
+        self.text = text
+        self.changes = dict(changes)
+        self.gesture = gesture
+
+    def do(self, doc: Document) -> None:
+        for cid, (old, new) in self.changes.items():
+            doc.apply_channel(cid, new, _first_difference(old, new))
+
+    def undo(self, doc: Document) -> None:
+        for cid, (old, new) in reversed(list(self.changes.items())):
+            doc.apply_channel(cid, old, _first_difference(new, old))
+
+    def merge(self, other: Command) -> bool:
+        if self.gesture is None or other.gesture != self.gesture or not isinstance(other, SetChannels):
+            return False
+        for cid, (old, new) in other.changes.items():
+            if cid in self.changes:
+                self.changes[cid] = (self.changes[cid][0], new)
+            else:
+                self.changes[cid] = (old, new)
+        return True
+
+    def is_noop(self) -> bool:
+        return all(old == new for old, new in self.changes.values())
+
+
+def _first_difference(a: Channel | None, b: Channel | None) -> float:
+    """Earliest time from which two versions of a channel may evaluate differently."""
+    if a is None or b is None or a.pre != b.pre or not a.keys or not b.keys:
+        return -math.inf
+    for ka, kb in zip(a.keys, b.keys):
+        if ka != kb:
+            # The span before a changed key changes too (its end value and slopes).
+            return _previous_key_time(a, ka.time, b, kb.time)
+    if len(a.keys) != len(b.keys):
+        n = min(len(a.keys), len(b.keys))
+        return _previous_key_time(a, a.keys[n - 1].time, b, b.keys[n - 1].time) if n else -math.inf
+    return a.keys[-1].time if a.post != b.post else math.inf
+
+
+def _previous_key_time(a: Channel, ta: float, b: Channel, tb: float) -> float:
+    # Smooth tangents reach one key further back, so go back two keys to be safe.
+    def back(ch: Channel, t: float) -> float:
+        times = [k.time for k in ch.keys if k.time < t]
+        return times[-2] if len(times) >= 2 else -math.inf
+    return min(back(a, ta), back(b, tb))
+
+
+def _get(doc: Document, cid: str) -> Channel:
+    return doc.channels.get(cid) or Channel()
+
+
+class InsertKey(SetChannels):
+    """Set a key (creating the channel if needed); a key at the same time is replaced."""
+
+    def __init__(self, doc: Document, cid: str, key: Key, gesture: Hashable | None = None,
+                 text: str = "Set Key") -> None:
+        old = doc.channels.get(cid)
+        new = (old or Channel()).set_key(key)
+        super().__init__(text, {cid: (old, new)}, gesture)
+
+
+class SetKeys(SetChannels):
+    """Set several keys at once: ``keys`` maps channel id to the key to set."""
+
+    def __init__(self, doc: Document, keys: dict[str, Key], text: str = "Set Keys",
+                 gesture: Hashable | None = None) -> None:
+        changes: dict[str, tuple[Channel | None, Channel | None]] = {}
+        for cid, key in keys.items():
+            old = doc.channels.get(cid)
+            changes[cid] = (old, (old or Channel()).set_key(key))
+        super().__init__(text, changes, gesture)
+
+
+class DeleteKeys(SetChannels):
+    """Delete keys by index: ``selection`` maps channel id to key indices."""
+
+    def __init__(self, doc: Document, selection: dict[str, Iterable[int]], text: str = "Delete Keys") -> None:
+        changes: dict[str, tuple[Channel | None, Channel | None]] = {}
+        for cid, idx in selection.items():
+            old = doc.channels.get(cid)
+            if old is not None:
+                changes[cid] = (old, old.remove_keys(idx))
+        super().__init__(text, changes)
+
+
+class MoveKeys(SetChannels):
+    """Move keys by ``(dt, dv)``, keeping each key's rules and slopes.
+
+    Built from the channels as they were when the drag began (``base``), so that a drag
+    merged from many mouse moves is exact: the last offset wins. Raises ValueError if a
+    moved key would land on another key's time.
+    """
+
+    def __init__(self, base: dict[str, Channel], selection: dict[str, Sequence[int]], dt: float,
+                 dv: float, gesture: Hashable | None = None, text: str = "Move Keys",
+                 time_scale: tuple[float, float] | None = None) -> None:
+        changes: dict[str, tuple[Channel | None, Channel | None]] = {}
+        for cid, idx in selection.items():
+            old = base[cid]
+            moved = {}
+            for i in idx:
+                k = old.keys[i]
+                t = k.time + dt
+                if time_scale is not None:
+                    pivot, factor = time_scale
+                    t = pivot + (k.time - pivot) * factor
+                moved[i] = k.moved(t, k.value + dv)
+            changes[cid] = (old, old.replace_keys(moved))
+        super().__init__(text, changes, gesture)
+
+
+class EditKey(SetChannels):
+    """Replace one key by an edited copy (numeric fields, handle drags, rule menus)."""
+
+    def __init__(self, doc: Document, cid: str, index: int, key: Key, text: str = "Edit Key",
+                 gesture: Hashable | None = None) -> None:
+        old = doc.channels[cid]
+        super().__init__(text, {cid: (old, old.replace_keys({index: key}))}, gesture)
+
+
+class SetTangents(SetChannels):
+    """Set the tangent rule of selected keys on the in side, the out side, or both."""
+
+    def __init__(self, doc: Document, selection: dict[str, Iterable[int]], rule: Tangent | str,
+                 side: str = "both", text: str | None = None) -> None:
+        rule = Tangent(rule)
+        if side not in ("in", "out", "both"):
+            raise ValueError("side must be 'in', 'out' or 'both'")
+        changes: dict[str, tuple[Channel | None, Channel | None]] = {}
+        for cid, idx in selection.items():
+            old = doc.channels[cid]
+            s_in, s_out = old.slopes()
+            edits = {}
+            for i in idx:
+                k = old.keys[i]
+                kw: dict[str, Any] = {}
+                if side in ("in", "both"):
+                    kw.update(in_tangent=rule, in_slope=float(s_in[i]) if rule is Tangent.FIXED else 0.0)
+                if side in ("out", "both"):
+                    kw.update(out_tangent=rule, out_slope=float(s_out[i]) if rule is Tangent.FIXED else 0.0)
+                edits[i] = _replace_key(k, **kw)
+            changes[cid] = (old, old.replace_keys(edits))
+        super().__init__(text or f"Tangents: {rule.value}", changes)
+
+
+class SetExtrapolation(SetChannels):
+    """Set pre and / or post extrapolation of channels."""
+
+    def __init__(self, doc: Document, cids: Iterable[str], pre: Extrapolation | str | None = None,
+                 post: Extrapolation | str | None = None, text: str = "Set Extrapolation") -> None:
+        changes: dict[str, tuple[Channel | None, Channel | None]] = {}
+        for cid in cids:
+            old = doc.channels[cid]
+            changes[cid] = (old, old.with_extrapolation(pre, post))
+        super().__init__(text, changes)
+
+
+def _replace_key(k: Key, **kw: Any) -> Key:
+    from dataclasses import replace
+    return replace(k, **kw)
+
+
+class SetParameter(Command):
+    """Set one parameter; consecutive sets of the same path in one gesture merge."""
+
+    def __init__(self, doc: Document, path: str, value: Any, text: str | None = None,
+                 gesture: Hashable | None = None) -> None:
+        self.path = path
+        self.old = doc.parameters.get(path)
+        self.new = value
+        self.text = text or f"Set {path}"
+        self.gesture = gesture if gesture is not None else ("parameter", path)
+
+    def do(self, doc: Document) -> None:
+        doc.apply_parameter(self.path, self.new)
+
+    def undo(self, doc: Document) -> None:
+        doc.apply_parameter(self.path, self.old)
+
+    def merge(self, other: Command) -> bool:
+        if isinstance(other, SetParameter) and other.path == self.path and other.gesture == self.gesture:
+            self.new = other.new
+            return True
+        return False
+
+    def is_noop(self) -> bool:
+        return bool(self.old == self.new)
+
+
+class AddAsset(Command):
+    """Add an asset (with the object loaded from its source, and any channels)."""
+
+    def __init__(self, asset: Asset, runtime: Any = None, channels: dict[str, Channel] | None = None,
+                 text: str | None = None) -> None:
+        self.asset = asset
+        self.runtime = runtime
+        self.channels = dict(channels or {})
+        self.text = text or f"Add {asset.id}"
+
+    def do(self, doc: Document) -> None:
+        doc.apply_asset(self.asset.id, self.asset, self.runtime)
+        for cid, ch in self.channels.items():
+            doc.apply_channel(cid, ch)
+
+    def undo(self, doc: Document) -> None:
+        for cid in self.channels:
+            doc.apply_channel(cid, None)
+        doc.apply_asset(self.asset.id, None)
+
+
+class RemoveAsset(Command):
+    """Remove an asset and its channels."""
+
+    def __init__(self, doc: Document, asset_id: str) -> None:
+        self.asset = doc.assets[asset_id]
+        self.runtime = doc.runtime.get(asset_id)
+        self.index = list(doc.assets).index(asset_id)
+        self.channels = dict(doc.channels_of(asset_id))
+        self.text = f"Remove {asset_id}"
+
+    def do(self, doc: Document) -> None:
+        for cid in self.channels:
+            doc.apply_channel(cid, None)
+        doc.apply_asset(self.asset.id, None)
+
+    def undo(self, doc: Document) -> None:
+        doc.apply_asset(self.asset.id, self.asset, self.runtime, index=self.index)
+        for cid, ch in self.channels.items():
+            doc.apply_channel(cid, ch)
+
+
+class SetAssetProperty(Command):
+    """Set one authored property of an asset (merges within a gesture)."""
+
+    def __init__(self, doc: Document, asset_id: str, name: str, value: Any,
+                 text: str | None = None, gesture: Hashable | None = None) -> None:
+        self.asset_id = asset_id
+        self.name = name
+        self.old = doc.assets[asset_id].properties.get(name)
+        self.new = value
+        self.text = text or f"Set {name}"
+        self.gesture = gesture if gesture is not None else ("asset-property", asset_id, name)
+
+    def _set(self, doc: Document, value: Any) -> None:
+        asset = doc.assets[self.asset_id]
+        if value is None:
+            asset.properties.pop(self.name, None)
+        else:
+            asset.properties[self.name] = value
+        doc.apply_asset(self.asset_id, asset)
+
+    def do(self, doc: Document) -> None:
+        self._set(doc, self.new)
+
+    def undo(self, doc: Document) -> None:
+        self._set(doc, self.old)
+
+    def merge(self, other: Command) -> bool:
+        if (isinstance(other, SetAssetProperty) and other.asset_id == self.asset_id
+                and other.name == self.name and other.gesture == self.gesture):
+            self.new = other.new
+            return True
+        return False
+
+
+class Macro(Command):
+    """Several commands as one undo step (e.g. an IK drag that keys many joints)."""
+
+    def __init__(self, text: str, commands: Sequence[Command], gesture: Hashable | None = None) -> None:
+        self.text = text
+        self.commands = list(commands)
+        self.gesture = gesture
+
+    def do(self, doc: Document) -> None:
+        for c in self.commands:
+            c.do(doc)
+
+    def undo(self, doc: Document) -> None:
+        for c in reversed(self.commands):
+            c.undo(doc)
+
+    def merge(self, other: Command) -> bool:
+        if self.gesture is None or other.gesture != self.gesture:
+            return False
+        if isinstance(other, Macro):
+            incoming = other.commands
+        else:
+            incoming = [other]
+        for c in incoming:
+            if not any(mine.merge(c) for mine in self.commands):
+                self.commands.append(c)
+        return True
+
+
+class UndoStack:
+    """A plain undo stack with merging, for scripts and tests without Qt.
+
+    The GUI uses QUndoStack through ``qtanimator.ui.undo`` with the same semantics.
+    """
+
+    def __init__(self, doc: Document) -> None:
+        self.doc = doc
+        self.done: list[Command] = []
+        self.undone: list[Command] = []
+
+    def push(self, cmd: Command) -> None:
+        cmd.do(self.doc)
+        self.undone.clear()
+        if self.done and self.done[-1].merge(cmd):
+            return
+        self.done.append(cmd)
+
+    def undo(self) -> bool:
+        if not self.done:
+            return False
+        cmd = self.done.pop()
+        cmd.undo(self.doc)
+        self.undone.append(cmd)
+        return True
+
+    def redo(self) -> bool:
+        if not self.undone:
+            return False
+        cmd = self.undone.pop()
+        cmd.do(self.doc)
+        self.done.append(cmd)
+        return True

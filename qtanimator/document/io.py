@@ -1,0 +1,45 @@
+"""Opening and saving documents as JSON projects."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from qtanimator.document.assets import load_runtime
+from qtanimator.document.document import PROJECT_DEFAULTS, Asset, Document
+from qtanimator.formats.project import AssetRecord, ProjectData, load_project, save_project
+
+
+def to_project_data(doc: Document) -> ProjectData:
+    return ProjectData(
+        parameters=dict(doc.parameters),
+        assets=[AssetRecord(a.id, a.kind, a.source, a.properties) for a in doc.assets.values()],
+        channels=dict(doc.channels),
+    )
+
+
+def document_from_project_data(data: ProjectData) -> Document:
+    """Build a document and load every asset's source (FormatError if one fails)."""
+    doc = Document()
+    doc.parameters = {**PROJECT_DEFAULTS, **data.parameters}
+    for rec in data.assets:
+        asset = Asset(rec.id, rec.kind, rec.source, dict(rec.properties))
+        doc.assets[asset.id] = asset
+        runtime = load_runtime(asset)
+        if runtime is not None:
+            doc.runtime[asset.id] = runtime
+    doc.channels = dict(data.channels)
+    return doc
+
+
+def open_document(path: str | os.PathLike[str]) -> Document:
+    """Read a project into a new document; the caller's document is never touched."""
+    doc = document_from_project_data(load_project(path))
+    doc.path = str(Path(path).resolve())
+    return doc
+
+
+def save_document(doc: Document, path: str | os.PathLike[str]) -> None:
+    """Save atomically and remember the path."""
+    save_project(to_project_data(doc), path)
+    doc.path = str(Path(path).resolve())

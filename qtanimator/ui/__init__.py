@@ -1,0 +1,1 @@
+"""Widgets: the main window and its editors. Everything here may import Qt."""

@@ -1,0 +1,39 @@
+"""The QUndoStack adapter: each Qt-free command becomes one QUndoCommand."""
+
+from __future__ import annotations
+
+from PySide6.QtGui import QUndoCommand, QUndoStack
+
+from qtanimator.document.commands import Command
+from qtanimator.document.document import Document
+
+_MERGE_ID = 0x51A  # any id other than -1 lets Qt ask mergeWith; Command.merge decides
+
+
+class DocumentUndoCommand(QUndoCommand):
+    def __init__(self, doc: Document, command: Command) -> None:
+        super().__init__(command.text)
+        self.doc = doc
+        self.command = command
+
+    def redo(self) -> None:
+        self.command.do(self.doc)
+
+    def undo(self) -> None:
+        self.command.undo(self.doc)
+
+    def id(self) -> int:
+        return _MERGE_ID if self.command.gesture is not None else -1
+
+    def mergeWith(self, other: QUndoCommand) -> bool:
+        if not isinstance(other, DocumentUndoCommand):
+            return False
+        merged = self.command.merge(other.command)
+        if merged:
+            self.setText(self.command.text)
+        return merged
+
+
+def push_command(stack: QUndoStack, doc: Document, command: Command) -> None:
+    """Do ``command`` and record it (merging with the previous one of the same gesture)."""
+    stack.push(DocumentUndoCommand(doc, command))

@@ -1,0 +1,109 @@
+"""Test session set-up: a private Xvfb for Qt (and real OpenGL through Mesa), or offscreen.
+
+At import time we try to start ``Xvfb -displayfd``. When it starts, every Qt test runs on
+the ``xcb`` platform on that private display, so QOpenGLWidget gets a real Mesa (llvmpipe)
+context. When it cannot start, widgets run on the ``offscreen`` platform and the tests
+marked ``gl`` are skipped with the reason.
+"""
+
+from __future__ import annotations
+
+import atexit
+import os
+import shutil
+import subprocess
+import tempfile
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[1]
+SHARED_DATA = (REPO / ".." / "shared" / "data").resolve()
+
+_xvfb_reason = ""
+
+
+def _start_xvfb() -> str | None:
+    """Start a private Xvfb and return its display name, or None with a reason set."""
+    global _xvfb_reason
+    if os.environ.get("QTANIMATOR_TEST_NO_XVFB"):
+        _xvfb_reason = "QTANIMATOR_TEST_NO_XVFB is set"
+        return None
+    exe = shutil.which("Xvfb")
+    if exe is None:
+        _xvfb_reason = "Xvfb is not installed (apt-get install xvfb)"
+        return None
+    read_fd, write_fd = os.pipe()
+    try:
+        proc = subprocess.Popen(
+            [exe, "-displayfd", str(write_fd), "-screen", "0", "1920x1080x24", "-nolisten", "tcp",
+             "+extension", "GLX", "-noreset"],
+            pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+        )
+    except OSError as exc:
+        _xvfb_reason = f"Xvfb did not start: {exc}"
+        return None
+    os.close(write_fd)
+    with os.fdopen(read_fd) as fh:
+        number = fh.readline().strip()
+    if not number:
+        proc.kill()
+        _xvfb_reason = "Xvfb started but reported no display"
+        return None
+    atexit.register(proc.terminate)
+    return f":{number}"
+
+
+def _configure_qt() -> None:
+    os.environ.setdefault("XDG_RUNTIME_DIR", tempfile.mkdtemp(prefix="qtanimator-xdg-"))
+    # Tests never read or write the user's settings or recent files.
+    os.environ["QTANIMATOR_SETTINGS_DIR"] = tempfile.mkdtemp(prefix="qtanimator-settings-")
+    display = _start_xvfb()
+    if display is not None:
+        os.environ["DISPLAY"] = display
+        os.environ["QT_QPA_PLATFORM"] = "xcb"
+        os.environ["QTANIMATOR_TEST_GL"] = "1"
+    else:
+        os.environ["QT_QPA_PLATFORM"] = "offscreen"
+        os.environ.pop("QTANIMATOR_TEST_GL", None)
+
+
+_configure_qt()
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if os.environ.get("QTANIMATOR_TEST_GL"):
+        return
+    skip = pytest.mark.skip(reason=f"no OpenGL context: {_xvfb_reason}")
+    for item in items:
+        if "gl" in item.keywords:
+            item.add_marker(skip)
+
+
+@pytest.fixture(scope="session")
+def shared_data() -> Path:
+    """The real public sample files; tests using this skip when they are absent."""
+    if not SHARED_DATA.is_dir():
+        pytest.skip(f"shared sample data not found at {SHARED_DATA}")
+    return SHARED_DATA
+
+
+@pytest.fixture(autouse=True)
+def dialog_log(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> list[tuple[str, str]]:
+    """Modal message boxes never block a test: questions answer Discard, and messages
+    (critical / warning / information) are recorded here as (title, text) instead."""
+    log: list[tuple[str, str]] = []
+    if "qtbot" not in request.fixturenames and "qapp" not in request.fixturenames:
+        return log
+    from PySide6.QtWidgets import QMessageBox
+
+    def record(_parent, title, text, *args, **kwargs):  # type: ignore[no-untyped-def]
+        log.append((str(title), str(text)))
+        return QMessageBox.StandardButton.Ok
+
+    monkeypatch.setattr(QMessageBox, "critical", staticmethod(record))
+    monkeypatch.setattr(QMessageBox, "warning", staticmethod(record))
+    monkeypatch.setattr(QMessageBox, "information", staticmethod(record))
+    monkeypatch.setattr(QMessageBox, "question",
+                        staticmethod(lambda *a, **k: QMessageBox.StandardButton.Discard))
+    return log
