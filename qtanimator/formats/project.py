@@ -13,7 +13,8 @@
                                                       "out": "smooth"}]}}
     }
 
-This module knows the schema only; :mod:`qtanimator.document.io` turns a
+Asset ``source`` paths and asset properties whose name ends in ``_file`` are stored
+relative to the project file and made absolute on load. This module knows the schema only; :mod:`qtanimator.document.io` turns a
 :class:`ProjectData` into a live document and back.
 """
 
@@ -57,7 +58,8 @@ def project_to_json(data: ProjectData, base_dir: str | os.PathLike[str]) -> str:
         source = a.source
         if source is not None:
             source = _relative(Path(source), base)
-        assets.append({"id": a.id, "kind": a.kind, "source": source, "properties": a.properties})
+        props = {k: (_relative(Path(v), base) if _is_path_key(k, v) else v) for k, v in a.properties.items()}
+        assets.append({"id": a.id, "kind": a.kind, "source": source, "properties": props})
     doc = {
         "format": FORMAT_NAME,
         "version": FORMAT_VERSION,
@@ -69,6 +71,11 @@ def project_to_json(data: ProjectData, base_dir: str | os.PathLike[str]) -> str:
         return json.dumps(doc, indent=2, allow_nan=False, ensure_ascii=False) + "\n"
     except ValueError as exc:  # NaN or infinity somewhere in the parameters
         raise ValueError(f"the project holds a value JSON cannot store: {exc}") from exc
+
+
+def _is_path_key(key: str, value: Any) -> bool:
+    """Asset properties named ``*_file`` hold file paths, saved relative to the project."""
+    return key.endswith("_file") and isinstance(value, str) and bool(value)
 
 
 def _relative(path: Path, base: Path) -> str:
@@ -145,6 +152,7 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
         if not isinstance(props, dict):
             raise FormatError(f"asset {a['id']!r}: \"properties\" must be an object.", p)
         abs_source = str((base / source).resolve()) if source else None
+        props = {k: (str((base / v).resolve()) if _is_path_key(k, v) else v) for k, v in props.items()}
         data.assets.append(AssetRecord(a["id"], a["kind"], abs_source, props))
     channels = obj.get("channels", {})
     if not isinstance(channels, dict):
