@@ -18,6 +18,7 @@ polynomial coefficients, no Python loop per sample.
 from __future__ import annotations
 
 import math
+from bisect import bisect_right
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
 from enum import StrEnum
@@ -47,6 +48,11 @@ class Extrapolation(StrEnum):
     CYCLE = "cycle"
     CYCLE_OFFSET = "cycle_offset"
     BOUNCE = "bounce"
+
+    @property
+    def periodic(self) -> bool:
+        """True for the modes that repeat the keys (cycle, cycle_offset, bounce)."""
+        return self in _PERIODIC
 
 
 class Interpolation(StrEnum):
@@ -126,18 +132,43 @@ def _rule_and_slope(tan: Tangent | str | float) -> tuple[Tangent, float]:
 
 _PERIODIC = (Extrapolation.CYCLE, Extrapolation.CYCLE_OFFSET, Extrapolation.BOUNCE)
 
+#: Large arrays are evaluated in blocks of this many samples, so that the dozen or so
+#: numpy passes per block stay in the CPU cache.
+_BLOCK = 65536
+
 
 @dataclass(frozen=True, eq=False)
 class _Compiled:
+    """Everything evaluation needs, computed once per channel.
+
+    The polynomial of span ``i`` is ``((a x + b) x + c) x + d`` with ``x = t − times[i]``
+    in seconds (the Hermite form of notes §8.2 with ``u = x/Δ`` folded into the
+    coefficients). Index ``n − 1`` is a sentinel "span" that starts at the last key: its
+    value is exactly the last key's value and its first and second derivatives are those
+    at the end of the last real span, so ``t == t_last`` needs no special case and a
+    stepped last span ends on its key.
+    """
+
     times: FloatArray
     values: FloatArray
     slope_in: FloatArray
     slope_out: FloatArray
-    # Per span (n - 1 of them): Hermite form ((A u + B) u + C) u + D over u in [0, 1].
-    coeffs: FloatArray  # shape (n - 1, 4): A, B, C, D
-    inv_dt: FloatArray
-    stepped: npt.NDArray[np.bool_]
-    any_stepped: bool
+    rel: FloatArray  # times − t0, computed exactly like ``t − t0`` for a sample
+    a: FloatArray
+    b: FloatArray
+    c: FloatArray
+    d: FloatArray
+    # Plain-float copies for the scalar path (bisect and Python arithmetic, same rounding).
+    rel_l: list[float]
+    coef_l: list[tuple[float, float, float, float]]
+    t0: float
+    t1: float
+    period: float
+    p0: float
+    p1: float
+    rise: float  # p_last − p0, the cycle_offset step
+    in0: float   # the first key's in slope (linear pre-extrapolation)
+    out1: float  # the last key's out slope (linear post-extrapolation)
 
 
 @dataclass(frozen=True, eq=True)
@@ -232,100 +263,144 @@ class Channel:
         """Value (``derivative=0``), slope (1) or curvature (2) at ``t`` seconds.
 
         Returns a float for a scalar time and a float64 array of the same shape for an
-        array of times.
+        array of times. At an interior key the derivatives are those of the span that
+        starts there (the out side).
         """
         if derivative not in (0, 1, 2):
             raise ValueError("derivative must be 0, 1 or 2")
-        scalar = np.ndim(t) == 0
+        if np.ndim(t) == 0:
+            return self._evaluate_scalar(float(t), derivative)
         tt = np.asarray(t, dtype=np.float64)
-        out = self._evaluate_array(tt.reshape(-1), derivative).reshape(tt.shape)
-        return float(out) if scalar else out
+        flat = tt.reshape(-1)
+        if flat.size <= _BLOCK:
+            out = self._evaluate_array(flat, derivative)
+        else:
+            out = np.empty_like(flat)
+            for s in range(0, flat.size, _BLOCK):
+                out[s:s + _BLOCK] = self._evaluate_array(flat[s:s + _BLOCK], derivative)
+        return out.reshape(tt.shape)
 
     def __call__(self, t: Any, derivative: int = 0) -> Any:
         return self.evaluate(t, derivative)
 
-    def _evaluate_array(self, t: FloatArray, d: int) -> FloatArray:
+    # The scalar and the array paths do the same floating-point operations in the same
+    # order, so they agree to the last bit (a test checks this).
+    def _evaluate_scalar(self, t: float, deriv: int) -> float:
+        n = len(self.keys)
+        if n == 0:
+            return 0.0
+        c = self._compile()
+        if n == 1:
+            return math.nan if math.isnan(t) else (c.p0 if deriv == 0 else 0.0)
+        w = t - c.t0
+        period = c.period
+        if 0.0 <= w <= period:
+            i = bisect_right(c.rel_l, w) - 1
+            return _poly(c.coef_l[i], w - c.rel_l[i], deriv)
+        if math.isnan(w):
+            return math.nan
+        before = w < 0.0
+        mode = self.pre if before else self.post
+        if mode is Extrapolation.CONSTANT:
+            return (c.p0 if before else c.p1) if deriv == 0 else 0.0
+        if mode is Extrapolation.LINEAR:
+            slope = c.in0 if before else c.out1
+            if deriv == 0:
+                return c.p0 + c.in0 * w if before else c.p1 + c.out1 * (t - c.t1)
+            return slope if deriv == 1 else 0.0
+        if not math.isfinite(w):
+            return math.nan  # an infinite time has no place in a period
+        k = float(math.floor(w / period))
+        u = min(max(w - k * period, 0.0), period)
+        odd = mode is Extrapolation.BOUNCE and math.fmod(k, 2.0) != 0.0
+        if odd:
+            u = period - u
+        i = max(bisect_right(c.rel_l, u) - 1, 0)
+        res = _poly(c.coef_l[i], u - c.rel_l[i], deriv)
+        if odd and deriv == 1:
+            res = -res
+        if mode is Extrapolation.CYCLE_OFFSET and deriv == 0:
+            res += k * c.rise
+        return res
+
+    def _evaluate_array(self, t: FloatArray, deriv: int) -> FloatArray:
         n = len(self.keys)
         if n == 0:
             return np.zeros_like(t)
         c = self._compile()
         if n == 1:
-            return np.full_like(t, c.values[0] if d == 0 else 0.0)
-        t0 = c.times[0]
-        t1 = c.times[-1]
-        before = t < t0
-        after = t > t1
-        any_before = bool(before.any())
-        any_after = bool(after.any())
-        if not (any_before or any_after):
-            return self._eval_inside(c, t, d)
-
-        local = t.copy()
-        offset = np.zeros_like(t) if d == 0 else None
-        sign = None
-        fixed_mask = np.zeros(t.shape, dtype=bool)
-        fixed_vals = np.zeros_like(t)
-        period = t1 - t0
-        for mask, mode, is_pre in ((before, self.pre, True), (after, self.post, False)):
-            if not mask.any():
-                continue
-            tm = t[mask]
-            if mode in _PERIODIC:
-                k = np.floor((tm - t0) / period)
-                u = np.clip((tm - t0) - k * period, 0.0, period)
-                if mode is Extrapolation.BOUNCE:
-                    odd = np.mod(k, 2.0) == 1.0
-                    local[mask] = np.where(odd, t1 - u, t0 + u)
-                    if d == 1:
-                        if sign is None:
-                            sign = np.ones_like(t)
-                        sign[mask] = np.where(odd, -1.0, 1.0)
-                else:
-                    local[mask] = t0 + u
-                    if mode is Extrapolation.CYCLE_OFFSET and offset is not None:
-                        offset[mask] = k * (c.values[-1] - c.values[0])
-            else:
-                fixed_mask |= mask
-                if mode is Extrapolation.LINEAR:
-                    slope = c.slope_in[0] if is_pre else c.slope_out[-1]
-                    anchor_t, anchor_v = (t0, c.values[0]) if is_pre else (t1, c.values[-1])
-                    vals = anchor_v + slope * (tm - anchor_t) if d == 0 else (
-                        np.full_like(tm, slope) if d == 1 else np.zeros_like(tm))
-                else:
-                    anchor_v = c.values[0] if is_pre else c.values[-1]
-                    vals = np.full_like(tm, anchor_v if d == 0 else 0.0)
-                fixed_vals[mask] = vals
-                local[mask] = t0  # any in-range time; overwritten below
-        result = self._eval_inside(c, local, d)
-        if offset is not None:
-            result += offset
-        if sign is not None:
-            result *= sign
-        if fixed_mask.any():
-            result[fixed_mask] = fixed_vals[fixed_mask]
-        return result
-
-    @staticmethod
-    def _eval_inside(c: _Compiled, t: FloatArray, d: int) -> FloatArray:
-        times = c.times
-        nspan = len(times) - 1
-        i = np.searchsorted(times, t, side="right") - 1
-        np.clip(i, 0, nspan - 1, out=i)
-        u = (t - times[i]) * c.inv_dt[i]
-        coef = c.coeffs[i]
-        a, b, cc, dd = coef[:, 0], coef[:, 1], coef[:, 2], coef[:, 3]
-        if d == 0:
-            res = ((a * u + b) * u + cc) * u + dd
-            if c.any_stepped:
-                # A stepped span holds its first key's value until the next key's time.
-                at_end = c.stepped[i] & (u >= 1.0)
-                if at_end.any():
-                    res[at_end] = c.values[i[at_end] + 1]
+            res = np.full_like(t, c.p0 if deriv == 0 else 0.0)
+            res[np.isnan(t)] = np.nan
             return res
-        if d == 1:
-            return ((3.0 * a * u + 2.0 * b) * u + cc) * c.inv_dt[i]
-        inv = c.inv_dt[i]
-        return (6.0 * a * u + 2.0 * b) * inv * inv
+        period = c.period
+        w = t - c.t0
+        if w.size and 0.0 <= w.min() and w.max() <= period:
+            # Fast path: every sample lies between the first and the last key.
+            i = np.searchsorted(c.rel, w, side="right")
+            i -= 1
+            return _poly_array(c, i, w - c.rel.take(i), deriv)
+        with np.errstate(invalid="ignore"):
+            return self._extrapolate_array(c, t, w, deriv)
+
+    def _extrapolate_array(self, c: _Compiled, t: FloatArray, w: FloatArray, deriv: int) -> FloatArray:
+        pre, post = self.pre, self.post
+        period = c.period
+        pre_p = pre in _PERIODIC
+        post_p = post in _PERIODIC
+        k: FloatArray | None = None
+        odd: npt.NDArray[np.bool_] | None = None
+        if pre_p or post_p:
+            # k = floor((t - t0) / d) outside the keys, 0 inside and on non-periodic sides.
+            q = np.floor(w / period)
+            if pre_p and post_p:
+                # floor gives 0 inside, except 1 at w == d exactly (the last key itself).
+                k = q
+                np.copyto(k, 0.0, where=w == period)
+            elif pre_p:
+                k = np.minimum(q, 0.0)
+            else:
+                k = np.where(w > period, q, 0.0)
+            u = k * period
+            np.subtract(w, u, out=u)
+            if pre is Extrapolation.BOUNCE or post is Extrapolation.BOUNCE:
+                odd = np.fmod(k, 2.0) != 0.0
+                if pre is not Extrapolation.BOUNCE:
+                    odd &= k > 0.0
+                elif post is not Extrapolation.BOUNCE:
+                    odd &= k < 0.0
+        else:
+            u = w.copy()
+        np.clip(u, 0.0, period, out=u)
+        if odd is not None:
+            u = np.where(odd, period - u, u)
+        # u >= 0 = rel[0], so i >= 0. NaN samples (and infinite ones in a periodic mode)
+        # sort after every key, land in the sentinel and stay NaN all the way through.
+        i = np.searchsorted(c.rel, u, side="right")
+        i -= 1
+        res = _poly_array(c, i, u - c.rel.take(i), deriv)
+        if odd is not None and deriv == 1:
+            np.negative(res, out=res, where=odd)
+        if k is not None and deriv == 0:
+            if pre is Extrapolation.CYCLE_OFFSET and post is Extrapolation.CYCLE_OFFSET:
+                res += k * c.rise
+            elif pre is Extrapolation.CYCLE_OFFSET:
+                res += np.minimum(k, 0.0) * c.rise
+            elif post is Extrapolation.CYCLE_OFFSET:
+                res += np.maximum(k, 0.0) * c.rise
+        if not pre_p:
+            fill: Any
+            if pre is Extrapolation.LINEAR:
+                fill = c.p0 + c.in0 * w if deriv == 0 else (c.in0 if deriv == 1 else 0.0)
+            else:
+                fill = c.p0 if deriv == 0 else 0.0
+            res = np.where(w < 0.0, fill, res)
+        if not post_p:
+            if post is Extrapolation.LINEAR:
+                fill = c.p1 + c.out1 * (t - c.t1) if deriv == 0 else (c.out1 if deriv == 1 else 0.0)
+            else:
+                fill = c.p1 if deriv == 0 else 0.0
+            res = np.where(w > period, fill, res)
+        return res
 
     def _compile(self) -> _Compiled:
         if self._compiled:
@@ -335,26 +410,41 @@ class Channel:
         times = np.array([k.time for k in keys], dtype=np.float64)
         values = np.array([k.value for k in keys], dtype=np.float64)
         s_in, s_out = _resolve_slopes(keys, times, values)
+        a = np.zeros(n)
+        b = np.zeros(n)
+        c = np.zeros(n)
+        d = values.copy()
         if n >= 2:
             dt = np.diff(times)
             p0, p1 = values[:-1], values[1:]
             interp = [k.interpolation for k in keys[:-1]]
             cubic = np.array([m is Interpolation.CUBIC for m in interp])
             linear = np.array([m is Interpolation.LINEAR for m in interp])
-            stepped = np.array([m is Interpolation.CONSTANT for m in interp])
+            # Hermite coefficients over u in [0, 1] (notes §8.2), then scaled to seconds.
             v0 = dt * s_out[:-1]
             v1 = dt * s_in[1:]
             A = np.where(cubic, 2 * p0 - 2 * p1 + v0 + v1, 0.0)
             B = np.where(cubic, -3 * p0 + 3 * p1 - 2 * v0 - v1, 0.0)
             C = np.where(cubic, v0, np.where(linear, p1 - p0, 0.0))
-            coeffs = np.stack([A, B, C, p0], axis=1)
-            inv_dt = 1.0 / dt
-        else:
-            coeffs = np.zeros((0, 4))
-            inv_dt = np.zeros(0)
-            stepped = np.zeros(0, dtype=bool)
-        comp = _Compiled(times, values, s_in, s_out, np.ascontiguousarray(coeffs), inv_dt,
-                         stepped, bool(stepped.any()))
+            inv = 1.0 / dt
+            a[:-1] = A * inv ** 3
+            b[:-1] = B * inv ** 2
+            c[:-1] = C * inv
+            # The sentinel continues the derivatives of the last span at its end.
+            h = dt[-1]
+            b[-1] = 3.0 * a[-2] * h + b[-2]
+            c[-1] = (3.0 * a[-2] * h + 2.0 * b[-2]) * h + c[-2]
+        t0 = float(times[0]) if n else 0.0
+        t1 = float(times[-1]) if n else 0.0
+        rel = times - t0
+        comp = _Compiled(
+            times, values, s_in, s_out, rel, a, b, c, d,
+            rel.tolist(), list(zip(a.tolist(), b.tolist(), c.tolist(), d.tolist())),
+            t0, t1, t1 - t0,
+            float(values[0]) if n else 0.0, float(values[-1]) if n else 0.0,
+            float(values[-1] - values[0]) if n else 0.0,
+            float(s_in[0]) if n else 0.0, float(s_out[-1]) if n else 0.0,
+        )
         self._compiled.append(comp)
         return comp
 
@@ -367,6 +457,39 @@ class Channel:
     def from_dict(cls, d: dict[str, Any]) -> Channel:
         return cls([Key.from_dict(k) for k in d.get("keys", [])],
                    d.get("pre", "constant"), d.get("post", "constant"))
+
+
+def _poly(coef: tuple[float, float, float, float], x: float, deriv: int) -> float:
+    a, b, c, d = coef
+    if deriv == 0:
+        return ((a * x + b) * x + c) * x + d
+    if deriv == 1:
+        return (3.0 * a * x + 2.0 * b) * x + c
+    return 6.0 * a * x + 2.0 * b
+
+
+def _poly_array(comp: _Compiled, i: npt.NDArray[np.intp], x: FloatArray, deriv: int) -> FloatArray:
+    """Evaluate span ``i`` at offset ``x`` (in place on temporaries, same order as _poly)."""
+    a = comp.a.take(i)
+    if deriv == 0:
+        a *= x
+        a += comp.b.take(i)
+        a *= x
+        a += comp.c.take(i)
+        a *= x
+        a += comp.d.take(i)
+        return a
+    if deriv == 1:
+        a *= 3.0
+        a *= x
+        a += 2.0 * comp.b.take(i)
+        a *= x
+        a += comp.c.take(i)
+        return a
+    a *= 6.0
+    a *= x
+    a += 2.0 * comp.b.take(i)
+    return a
 
 
 def _resolve_slopes(keys: Sequence[Key], times: FloatArray,

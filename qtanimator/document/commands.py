@@ -52,12 +52,12 @@ class SetChannels(Command):
         self.gesture = gesture
 
     def do(self, doc: Document) -> None:
-        for cid, (old, new) in self.changes.items():
-            doc.apply_channel(cid, new, _first_difference(old, new))
+        for cid, (_old, new) in self.changes.items():
+            doc.apply_channel(cid, new, _first_difference(doc.channels.get(cid), new))
 
     def undo(self, doc: Document) -> None:
-        for cid, (old, new) in reversed(list(self.changes.items())):
-            doc.apply_channel(cid, old, _first_difference(new, old))
+        for cid, (old, _new) in reversed(list(self.changes.items())):
+            doc.apply_channel(cid, old, _first_difference(doc.channels.get(cid), old))
 
     def merge(self, other: Command) -> bool:
         if self.gesture is None or other.gesture != self.gesture or not isinstance(other, SetChannels):
@@ -77,6 +77,10 @@ def _first_difference(a: Channel | None, b: Channel | None) -> float:
     """Earliest time from which two versions of a channel may evaluate differently."""
     if a is None or b is None or a.pre != b.pre or not a.keys or not b.keys:
         return -math.inf
+    if a == b:
+        return math.inf
+    if a.pre.periodic:
+        return -math.inf  # a cycle before the first key repeats every key
     for ka, kb in zip(a.keys, b.keys):
         if ka != kb:
             # The span before a changed key changes too (its end value and slopes).
@@ -211,7 +215,11 @@ def _replace_key(k: Key, **kw: Any) -> Key:
 
 
 class SetParameter(Command):
-    """Set one parameter; consecutive sets of the same path in one gesture merge."""
+    """Set one parameter; consecutive sets of the same path in one gesture merge.
+
+    Without a ``gesture`` every set is its own undo step (typing 24 then 30 into the fps
+    field is two steps); a slider passes one token per drag.
+    """
 
     def __init__(self, doc: Document, path: str, value: Any, text: str | None = None,
                  gesture: Hashable | None = None) -> None:
@@ -219,7 +227,7 @@ class SetParameter(Command):
         self.old = doc.parameters.get(path)
         self.new = value
         self.text = text or f"Set {path}"
-        self.gesture = gesture if gesture is not None else ("parameter", path)
+        self.gesture = gesture
 
     def do(self, doc: Document) -> None:
         doc.apply_parameter(self.path, self.new)
@@ -228,7 +236,8 @@ class SetParameter(Command):
         doc.apply_parameter(self.path, self.old)
 
     def merge(self, other: Command) -> bool:
-        if isinstance(other, SetParameter) and other.path == self.path and other.gesture == self.gesture:
+        if (self.gesture is not None and isinstance(other, SetParameter) and other.path == self.path
+                and other.gesture == self.gesture):
             self.new = other.new
             return True
         return False
@@ -238,7 +247,11 @@ class SetParameter(Command):
 
 
 class AddAsset(Command):
-    """Add an asset (with the object loaded from its source, and any channels)."""
+    """Add an asset (with the object loaded from its source, and any channels).
+
+    Whatever it replaces (an asset of the same id, channels of the same ids) is
+    remembered when it is done and put back on undo.
+    """
 
     def __init__(self, asset: Asset, runtime: Any = None, channels: dict[str, Channel] | None = None,
                  text: str | None = None) -> None:
@@ -246,16 +259,26 @@ class AddAsset(Command):
         self.runtime = runtime
         self.channels = dict(channels or {})
         self.text = text or f"Add {asset.id}"
+        self._replaced: tuple[Asset | None, Any, int | None, dict[str, Channel | None]] | None = None
 
     def do(self, doc: Document) -> None:
-        doc.apply_asset(self.asset.id, self.asset, self.runtime)
+        aid = self.asset.id
+        index = list(doc.assets).index(aid) if aid in doc.assets else None
+        self._replaced = (doc.assets.get(aid), doc.runtime.get(aid), index,
+                          {cid: doc.channels.get(cid) for cid in self.channels})
+        if index is not None:
+            doc.apply_asset(aid, None)
+        doc.apply_asset(aid, self.asset, self.runtime, index=index)
         for cid, ch in self.channels.items():
             doc.apply_channel(cid, ch)
 
     def undo(self, doc: Document) -> None:
-        for cid in self.channels:
-            doc.apply_channel(cid, None)
+        old_asset, old_runtime, index, old_channels = self._replaced or (None, None, None, {})
+        for cid in reversed(list(self.channels)):
+            doc.apply_channel(cid, old_channels.get(cid))
         doc.apply_asset(self.asset.id, None)
+        if old_asset is not None:
+            doc.apply_asset(self.asset.id, old_asset, old_runtime, index=index)
 
 
 class RemoveAsset(Command):
@@ -289,10 +312,11 @@ class SetAssetProperty(Command):
         self.old = doc.assets[asset_id].properties.get(name)
         self.new = value
         self.text = text or f"Set {name}"
-        self.gesture = gesture if gesture is not None else ("asset-property", asset_id, name)
+        self.gesture = gesture
 
     def _set(self, doc: Document, value: Any) -> None:
-        asset = doc.assets[self.asset_id]
+        # Assets are replaced, not changed in place: other commands keep the old object.
+        asset = doc.assets[self.asset_id].copy()
         if value is None:
             asset.properties.pop(self.name, None)
         else:
@@ -306,11 +330,14 @@ class SetAssetProperty(Command):
         self._set(doc, self.old)
 
     def merge(self, other: Command) -> bool:
-        if (isinstance(other, SetAssetProperty) and other.asset_id == self.asset_id
+        if (self.gesture is not None and isinstance(other, SetAssetProperty) and other.asset_id == self.asset_id
                 and other.name == self.name and other.gesture == self.gesture):
             self.new = other.new
             return True
         return False
+
+    def is_noop(self) -> bool:
+        return bool(self.old == self.new)
 
 
 class Macro(Command):
@@ -332,14 +359,16 @@ class Macro(Command):
     def merge(self, other: Command) -> bool:
         if self.gesture is None or other.gesture != self.gesture:
             return False
-        if isinstance(other, Macro):
-            incoming = other.commands
-        else:
-            incoming = [other]
+        incoming = other.commands if isinstance(other, Macro) else [other]
         for c in incoming:
-            if not any(mine.merge(c) for mine in self.commands):
+            # Only the last command may absorb it: merging into an earlier one would
+            # reorder edits when a later command touches the same channel.
+            if not (self.commands and self.commands[-1].merge(c)):
                 self.commands.append(c)
         return True
+
+    def is_noop(self) -> bool:
+        return all(c.is_noop() for c in self.commands)
 
 
 class UndoStack:
@@ -354,11 +383,17 @@ class UndoStack:
         self.undone: list[Command] = []
 
     def push(self, cmd: Command) -> None:
+        """Do ``cmd`` and record it. Like QUndoStack with obsolete commands, a command
+        that changes nothing is not recorded, and a gesture merged back to where it
+        started disappears from the history."""
         cmd.do(self.doc)
         self.undone.clear()
         if self.done and self.done[-1].merge(cmd):
+            if self.done[-1].is_noop():
+                self.done.pop()
             return
-        self.done.append(cmd)
+        if not cmd.is_noop():
+            self.done.append(cmd)
 
     def undo(self) -> bool:
         if not self.done:

@@ -7,6 +7,7 @@ from pathlib import Path
 
 from qtanimator.document.assets import load_runtime
 from qtanimator.document.document import PROJECT_DEFAULTS, Asset, Document
+from qtanimator.formats.errors import FormatError
 from qtanimator.formats.project import AssetRecord, ProjectData, load_project, save_project
 
 
@@ -25,7 +26,11 @@ def document_from_project_data(data: ProjectData) -> Document:
     for rec in data.assets:
         asset = Asset(rec.id, rec.kind, rec.source, dict(rec.properties))
         doc.assets[asset.id] = asset
-        runtime = load_runtime(asset)
+        try:
+            runtime = load_runtime(asset)
+        except OSError as exc:  # a loader that let a missing or unreadable file through
+            raise FormatError(f"asset {asset.id!r}: cannot read {exc.filename or asset.source!r} "
+                              f"({exc.strerror or exc}).", rec.source) from exc
         if runtime is not None:
             doc.runtime[asset.id] = runtime
     doc.channels = dict(data.channels)

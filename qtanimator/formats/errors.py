@@ -20,6 +20,10 @@ class FormatError(ValueError):
         self.column = column
         super().__init__(self._render())
 
+    def __reduce__(self) -> tuple[type[FormatError], tuple[str, str | None, int | None, int | None]]:
+        # Keep path, line and column when the error crosses a process boundary (pickle).
+        return (type(self), (self.message, self.path, self.line, self.column))
+
     def _render(self) -> str:
         where = []
         if self.path is not None:

@@ -23,6 +23,8 @@ SUMMARISERS: dict[str, tuple[str, str]] = {
     ".skel": ("qtanimator.formats.skel", "summarize"),
     ".skin": ("qtanimator.formats.skin", "summarize"),
     ".obj": ("qtanimator.formats.obj", "summarize"),
+    ".attach": ("qtanimator.formats.attach", "summarize"),
+    ".morph": ("qtanimator.formats.morph", "summarize"),
     ".bvh": ("qtanimator.formats.bvh", "summarize"),
     ".glb": ("qtanimator.formats.gltf", "summarize"),
     ".gltf": ("qtanimator.formats.gltf", "summarize"),
@@ -38,8 +40,11 @@ def summarize(path: Path) -> dict[str, Any]:
     entry = SUMMARISERS.get(suffix)
     if entry is None:
         raise FormatError(f"qtanimator does not read '{path.suffix}' files.", path)
-    module = importlib.import_module(entry[0])
-    fn: Summariser = getattr(module, entry[1])
+    try:
+        module = importlib.import_module(entry[0])
+        fn: Summariser = getattr(module, entry[1])
+    except (ImportError, AttributeError) as exc:
+        raise FormatError(f"this qtanimator cannot summarise '{suffix}' files yet.", path) from exc
     return fn(path)
 
 

@@ -14,8 +14,8 @@
     }
 
 Asset ``source`` paths and asset properties whose name ends in ``_file`` are stored
-relative to the project file and made absolute on load. This module knows the schema only; :mod:`qtanimator.document.io` turns a
-:class:`ProjectData` into a live document and back.
+relative to the project file and made absolute on load. This module knows the schema only;
+:mod:`qtanimator.document.io` turns a :class:`ProjectData` into a live document and back.
 """
 
 from __future__ import annotations
@@ -69,7 +69,7 @@ def project_to_json(data: ProjectData, base_dir: str | os.PathLike[str]) -> str:
     }
     try:
         return json.dumps(doc, indent=2, allow_nan=False, ensure_ascii=False) + "\n"
-    except ValueError as exc:  # NaN or infinity somewhere in the parameters
+    except (TypeError, ValueError) as exc:  # NaN, infinity or a non-JSON object in the parameters
         raise ValueError(f"the project holds a value JSON cannot store: {exc}") from exc
 
 
@@ -110,7 +110,7 @@ def load_project(path: str | os.PathLike[str]) -> ProjectData:
 def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
     p = Path(path)
     try:
-        obj = json.loads(text, parse_constant=_reject_constant)
+        obj = json.loads(text, parse_constant=_reject_constant, parse_float=_parse_float)
     except json.JSONDecodeError as exc:
         raise FormatError(f"the file is not valid JSON ({exc.msg}); it may be truncated.",
                           p, exc.lineno, exc.colno) from exc
@@ -134,6 +134,7 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
     params = obj.get("parameters", {})
     if not isinstance(params, dict):
         raise FormatError("\"parameters\" must be an object.", p)
+    _check_parameters(params, p)
     data.parameters = params
     assets = obj.get("assets", [])
     if not isinstance(assets, list):
@@ -151,8 +152,8 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
         props = a.get("properties", {})
         if not isinstance(props, dict):
             raise FormatError(f"asset {a['id']!r}: \"properties\" must be an object.", p)
-        abs_source = str((base / source).resolve()) if source else None
-        props = {k: (str((base / v).resolve()) if _is_path_key(k, v) else v) for k, v in props.items()}
+        abs_source = _absolute(base, source, p) if source else None
+        props = {k: (_absolute(base, v, p) if _is_path_key(k, v) else v) for k, v in props.items()}
         data.assets.append(AssetRecord(a["id"], a["kind"], abs_source, props))
     channels = obj.get("channels", {})
     if not isinstance(channels, dict):
@@ -162,9 +163,34 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
             raise FormatError(f"channel {cid!r} is not of the form asset/joint/dof with an object value.", p)
         try:
             data.channels[cid] = _channel_from_json(ch)
-        except (KeyError, TypeError, ValueError) as exc:
+        except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise FormatError(f"channel {cid!r} is malformed: {exc}.", p) from exc
     return data
+
+
+def _absolute(base: Path, relative: str, p: Path) -> str:
+    try:
+        return str((base / relative).resolve())
+    except (OSError, ValueError, RuntimeError) as exc:  # NUL bytes, symlink loops
+        raise FormatError(f"the asset path {relative!r} is not a usable path ({exc}).", p) from exc
+
+
+def _check_parameters(params: dict[str, Any], p: Path) -> None:
+    """The parameters every document relies on must make sense."""
+    fps = params.get("fps", 60.0)
+    if isinstance(fps, bool) or not isinstance(fps, (int, float)) or not 0 < fps <= 10000:
+        raise FormatError(f"\"fps\" must be a positive number of frames per second, not {fps!r}.", p)
+    for name in ("frame_start", "frame_end"):
+        value = params.get(name, 0)
+        if isinstance(value, bool) or not isinstance(value, int) or abs(value) > 10**9:
+            raise FormatError(f"\"{name}\" must be a whole frame number, not {value!r}.", p)
+
+
+def _parse_float(text: str) -> float:
+    value = float(text)
+    if not math.isfinite(value):
+        raise ValueError(f"the number {text} is too large for a project.")
+    return value
 
 
 def _channel_from_json(d: dict[str, Any]) -> Channel:

@@ -52,12 +52,15 @@ class EditorContext(QObject):
         """Take over ``new`` (already fully loaded) and clear the undo history."""
         self.undo_stack.clear()
         self._selection = ("", "")
+        had_channels = bool(self._channel_selection)
         self._channel_selection = []
         self.doc.replace_all(new)
         self.undo_stack.setClean()
         start, _end = self.doc.frame_range
         self.set_frame(float(start))
         self.selectionChanged.emit("", "")
+        if had_channels:
+            self.channelSelectionChanged.emit([])
 
     # ------------------------------------------------------------------- time
     @property

@@ -12,6 +12,7 @@ import os
 from collections.abc import Callable
 from pathlib import Path
 
+import shiboken6
 from PySide6.QtCore import QByteArray, QSettings, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QDragEnterEvent, QDropEvent, QKeySequence
 from PySide6.QtWidgets import (
@@ -86,7 +87,9 @@ class MainWindow(QMainWindow):
                         raise
                     continue
                 module.install(self)
-        self.ctx.undo_stack.cleanChanged.connect(lambda _clean: self._update_title())
+        # The undo stack is cleared while the window is destroyed: ignore that signal then.
+        self.ctx.undo_stack.cleanChanged.connect(
+            lambda _clean: shiboken6.isValid(self) and self._update_title())
         self.ctx.documentReset.connect(self._update_title)
         self._restore_layout()
         self._update_title()
@@ -220,9 +223,11 @@ class MainWindow(QMainWindow):
             else:
                 raise FormatError("qtanimator does not know this kind of file.", p)
         except FormatError as exc:
+            self._forget_if_gone(p)
             self.show_error("Cannot open file", str(exc))
             return False
         except OSError as exc:
+            self._forget_if_gone(p)
             self.show_error("Cannot open file", f"{p.name}: {exc.strerror or exc}")
             return False
         self._remember_recent(p)
@@ -270,6 +275,16 @@ class MainWindow(QMainWindow):
         s.setValue("recentFiles", recent[:MAX_RECENT])
         s.setValue("lastDir", str(path.resolve().parent))
         self._refresh_recent_menu()
+
+    def _forget_if_gone(self, path: Path) -> None:
+        """A recent file that no longer exists leaves the Recent menu."""
+        if path.exists():
+            return
+        full = str(path.resolve())
+        recent = self.recent_files()
+        if full in recent:
+            settings().setValue("recentFiles", [r for r in recent if r != full])
+            self._refresh_recent_menu()
 
     def _refresh_recent_menu(self) -> None:
         self.recent_menu.clear()

@@ -31,9 +31,25 @@ class DocumentUndoCommand(QUndoCommand):
         merged = self.command.merge(other.command)
         if merged:
             self.setText(self.command.text)
+            # A drag that ends where it began leaves no step behind.
+            self.setObsolete(self.command.is_noop())
         return merged
 
 
 def push_command(stack: QUndoStack, doc: Document, command: Command) -> None:
-    """Do ``command`` and record it (merging with the previous one of the same gesture)."""
+    """Do ``command`` and record it (merging with the previous one of the same gesture).
+
+    A command that changes nothing is done but not recorded (Qt drops obsolete commands).
+    """
+    if command.is_noop() and not _continues_gesture(stack, command):
+        command.do(doc)
+        return
     stack.push(DocumentUndoCommand(doc, command))
+
+
+def _continues_gesture(stack: QUndoStack, command: Command) -> bool:
+    # QUndoStack does not merge into the command a save marked clean.
+    if command.gesture is None or stack.index() == 0 or stack.index() == stack.cleanIndex():
+        return False
+    top = stack.command(stack.index() - 1)
+    return isinstance(top, DocumentUndoCommand) and top.command.gesture == command.gesture

@@ -1,0 +1,139 @@
+"""Cloth assets in the document: creation, parameter edits and a per-frame simulation cache.
+
+A cloth asset has ``kind == "cloth"``, no source file, and ``ClothParams.to_dict()`` as its
+properties. Its runtime object (``doc.runtime[asset_id]``) is a :class:`ClothCache`: the live
+simulation plus the positions of every frame simulated so far. Frame ``frame_start`` is the
+rest state; frame ``f`` is ``f − frame_start`` steps of ``1/fps`` later (fractional frames
+round down). Asking for a frame past the cache steps forward from the last cached frame. The
+cache is rebuilt when the asset's properties, the fps or ``frame_start`` change (undo included),
+because it compares them with the ones it was built from on every call.
+
+When the simulation blows up, :func:`cloth_state` keeps returning the last good frame and
+:func:`cloth_problem` returns the :class:`~qtanimator.core.cloth.ClothBlowUp` whose message
+says which parameter to change.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from collections.abc import Hashable
+from typing import Any
+
+import numpy as np
+
+from qtanimator.core.cloth import Cloth, ClothBlowUp, ClothParams, FloatArray
+from qtanimator.document.commands import AddAsset, Command, SetAssetProperty
+from qtanimator.document.document import Asset, Document
+from qtanimator.formats.errors import FormatError
+
+ASSET_KIND = "cloth"
+
+
+class ClothCache:
+    """The runtime object of a cloth asset: a live :class:`Cloth` and per-frame positions."""
+
+    def __init__(self, properties: dict[str, Any], fps: float = 60.0, frame_start: int = 0) -> None:
+        self.properties = copy.deepcopy(properties)
+        self.params = ClothParams.from_dict(properties)
+        self.fps = float(fps)
+        self.frame_start = int(frame_start)
+        self.cloth = Cloth(self.params)
+        self.frames: list[FloatArray] = [self._freeze(self.cloth.positions)]
+        self.error: ClothBlowUp | None = None
+
+    @staticmethod
+    def _freeze(a: FloatArray) -> FloatArray:
+        out = np.array(a, dtype=np.float64)
+        out.flags.writeable = False
+        return out
+
+    def matches(self, properties: dict[str, Any], fps: float, frame_start: int) -> bool:
+        return self.properties == properties and self.fps == float(fps) and self.frame_start == int(frame_start)
+
+    @property
+    def triangles(self) -> Any:
+        return self.cloth.triangles
+
+    def positions(self, frame: float) -> FloatArray:
+        """Positions at ``frame`` (read-only array), simulating forward as needed."""
+        if not math.isfinite(frame):
+            raise ValueError("frame must be finite")
+        k = max(0, math.floor(frame + 1e-9) - self.frame_start)
+        dt = 1.0 / self.fps
+        while len(self.frames) <= k and self.error is None:
+            try:
+                self.cloth.step(dt)
+            except ClothBlowUp as exc:
+                self.error = exc
+                break
+            self.frames.append(self._freeze(self.cloth.positions))
+        return self.frames[min(k, len(self.frames) - 1)]
+
+    @property
+    def cached_frames(self) -> int:
+        """How many frames (from ``frame_start``) are cached, the rest state included."""
+        return len(self.frames)
+
+
+def load_cloth_asset(asset: Asset) -> ClothCache:
+    """The loader for cloth assets (registered in ``qtanimator.document.loaders``)."""
+    try:
+        return ClothCache(asset.properties)
+    except (ValueError, TypeError, KeyError) as exc:
+        raise FormatError(f"cloth '{asset.id}' has an invalid parameter: {exc}") from exc
+
+
+def add_cloth_command(doc: Document, params: ClothParams | None = None, asset_id: str | None = None) -> Command:
+    """A command that adds a cloth asset (id ``cloth``, ``cloth_2``… unless given)."""
+    params = ClothParams() if params is None else params
+    params.validate()
+    aid = asset_id if asset_id is not None else doc.unique_asset_id("cloth")
+    if aid in doc.assets:
+        raise ValueError(f"there is already an asset called {aid!r}")
+    asset = Asset(aid, ASSET_KIND, None, params.to_dict())
+    start = doc.frame_range[0]
+    return AddAsset(asset, runtime=ClothCache(asset.properties, doc.fps, start), text="Add Cloth")
+
+
+def cloth_params(doc: Document, asset_id: str) -> ClothParams:
+    """The parameters of a cloth asset as a ClothParams."""
+    asset = doc.assets[asset_id]
+    if asset.kind != ASSET_KIND:
+        raise ValueError(f"asset {asset_id!r} is a {asset.kind}, not a cloth")
+    return ClothParams.from_dict(asset.properties)
+
+
+def set_cloth_param_command(doc: Document, asset_id: str, name: str, value: Any,
+                            gesture: Hashable | None = None) -> Command:
+    """A command that sets one cloth parameter (validated; ValueError names a bad value).
+
+    Commands with the same ``gesture`` merge into one undo step (a slider drag).
+    """
+    params = cloth_params(doc, asset_id).replace(**{name: value})
+    stored = params.to_dict()[name]
+    return SetAssetProperty(doc, asset_id, name, stored, text=f"Set cloth {name.replace('_', ' ')}",
+                            gesture=gesture)
+
+
+def cloth_cache(doc: Document, asset_id: str) -> ClothCache:
+    """The up-to-date cache of a cloth asset (rebuilt when its inputs changed)."""
+    asset = doc.assets[asset_id]
+    if asset.kind != ASSET_KIND:
+        raise ValueError(f"asset {asset_id!r} is a {asset.kind}, not a cloth")
+    start = doc.frame_range[0]
+    cache = doc.runtime.get(asset_id)
+    if not isinstance(cache, ClothCache) or not cache.matches(asset.properties, doc.fps, start):
+        cache = ClothCache(asset.properties, doc.fps, start)
+        doc.runtime[asset_id] = cache
+    return cache
+
+
+def cloth_state(doc: Document, asset_id: str, frame: float) -> FloatArray:
+    """Positions (N, 3) of a cloth asset at ``frame``; a read-only array, never NaN."""
+    return cloth_cache(doc, asset_id).positions(frame)
+
+
+def cloth_problem(doc: Document, asset_id: str) -> ClothBlowUp | None:
+    """The blow-up that stopped this cloth's cached simulation, if any."""
+    return cloth_cache(doc, asset_id).error

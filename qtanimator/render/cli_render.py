@@ -1,0 +1,158 @@
+"""``qtanimator render SCENE -o OUT``: render without a window.
+
+SCENE is a project (``.qtanim``) or an SVG character file or folder. OUT is a folder, a
+``frame_%04d.png`` pattern, a ``.gif`` or a video (``.mp4``). Dynamic joints are simulated
+(the pendulum cache steps forward frame by frame). The camera is fixed: the union of the
+scene's bounds over the rendered frames, fitted into ``--size``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+from collections.abc import Iterator, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from qtanimator.formats.errors import FormatError
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="qtanimator render",
+                                description="Render a project or SVG character to PNG frames, a GIF or a video.")
+    p.add_argument("scene", help="a project (.qtanim), an SVG character, or a folder of SVG characters")
+    p.add_argument("-o", "--output", required=True,
+                   help="a folder, a pattern such as frames/frame_%%04d.png, a .gif or an .mp4")
+    p.add_argument("--frames", help="frame range A:B (inclusive); the project's range by default")
+    p.add_argument("--fps", type=float, help="frames per second (the project's by default)")
+    p.add_argument("--size", default="960x640", help="image size WxH (default 960x640)")
+    p.add_argument("--background", default="white",
+                   help="a colour name or #rrggbb, or 'transparent' (default white)")
+    p.add_argument("--view", choices=("2d", "3d"), default="2d", help="the 2D renderer or the 3D viewport")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    return p
+
+
+def _parse_size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(v) for v in text.lower().split("x"))
+    except ValueError:
+        raise ValueError(f"--size must look like 960x640, got '{text}'") from None
+    if w <= 0 or h <= 0 or w > 16384 or h > 16384:
+        raise ValueError(f"--size must be between 1x1 and 16384x16384, got '{text}'")
+    return w, h
+
+
+def _parse_frames(text: str | None, default: tuple[int, int]) -> tuple[int, int]:
+    if text is None:
+        return default
+    try:
+        a, b = text.split(":")
+        first = int(a) if a.strip() else default[0]
+        last = int(b) if b.strip() else default[1]
+    except ValueError:
+        raise ValueError(f"--frames must look like 0:120, got '{text}'") from None
+    if last < first:
+        raise ValueError(f"--frames: the last frame ({last}) comes before the first ({first})")
+    return first, last
+
+
+def load_scene(path: str | os.PathLike[str]) -> Any:
+    """A document for a project or an SVG character / folder."""
+    from qtanimator.document import Document, open_document
+
+    p = Path(path)
+    if not p.exists():
+        raise FormatError("no such file or folder.", p)
+    if p.is_file() and p.suffix.lower() in (".qtanim", ".json"):
+        return open_document(p)
+    if p.is_dir() or p.suffix.lower() == ".svg":
+        from qtanimator.document.character2d import add_characters_command
+
+        doc = Document()
+        add_characters_command(doc, p).do(doc)
+        doc.path = None
+        return doc
+    raise FormatError(f"qtanimator render reads projects (.qtanim) and SVG characters, not "
+                      f"'{p.suffix}' files.", p)
+
+
+def _ensure_gui_app() -> Any:
+    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        if not os.environ.get("QT_QPA_PLATFORM"):
+            os.environ["QT_QPA_PLATFORM"] = "offscreen"
+    from PySide6.QtGui import QGuiApplication
+
+    return QGuiApplication.instance() or QGuiApplication(["qtanimator-render"])
+
+
+class _Progress:
+    def __init__(self, total: int, enabled: bool) -> None:
+        self.total = max(total, 1)
+        self.enabled = enabled
+
+    def __call__(self, done: int) -> None:
+        if not self.enabled:
+            return
+        width = 30
+        filled = int(width * done / self.total)
+        sys.stderr.write(f"\rrendering [{'#' * filled}{'.' * (width - filled)}] {done}/{self.total}")
+        if done >= self.total:
+            sys.stderr.write("\n")
+        sys.stderr.flush()
+
+
+def frames_2d(doc: Any, times: Sequence[float], size: tuple[int, int], background: str) -> Iterator[np.ndarray]:
+    """RGBA frames of the 2D characters at ``times`` with a steady camera."""
+    from qtanimator.render.painter2d import animation_bounds, image_to_array, render_frame
+
+    view = animation_bounds(doc, times)
+    for t in times:
+        yield image_to_array(render_frame(doc, t, size, background, view=view))
+
+
+def render_main(argv: Sequence[str]) -> int:
+    """Entry point of ``qtanimator render``; returns the exit status."""
+    ns = _parser().parse_args(list(argv))
+    try:
+        size = _parse_size(ns.size)
+        doc = load_scene(ns.scene)
+        if ns.fps is not None:
+            if not ns.fps > 0:
+                raise ValueError("--fps must be positive")
+            doc.parameters["fps"] = float(ns.fps)
+        first, last = _parse_frames(ns.frames, doc.frame_range)
+        fps = doc.fps
+        times = [f / fps for f in range(first, last + 1)]
+        from qtanimator.render.export import output_kind, write_frames
+
+        output_kind(ns.output)
+        if ns.view == "3d":
+            try:
+                from qtanimator.render import render3d
+                from qtanimator.render.render3d import render_frames_3d
+            except ImportError as exc:
+                print(f"qtanimator render: the 3D view is not available ({exc}).", file=sys.stderr)
+                return 2
+            # the 3D renderer knows how to get a GL-capable platform (a private Xvfb headless)
+            getattr(render3d, "ensure_gui_application", _ensure_gui_app)()
+        else:
+            _ensure_gui_app()
+        from qtanimator.render.painter2d import background_color
+
+        background_color(ns.background)
+        if ns.view == "3d":
+            frames: Any = render_frames_3d(doc, times, size)
+        else:
+            frames = frames_2d(doc, times, size, ns.background)
+        progress = _Progress(len(times), not ns.quiet)
+        n = write_frames(frames, ns.output, fps, progress=progress, start=first)
+    except (FormatError, ValueError, OSError) as exc:
+        print(f"qtanimator render: {exc}", file=sys.stderr)
+        return 1
+    if not ns.quiet:
+        print(f"wrote {n} frames to {ns.output}", file=sys.stderr)
+    return 0

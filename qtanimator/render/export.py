@@ -1,0 +1,167 @@
+"""Writing rendered frames: a PNG sequence, a GIF or a video (imageio + imageio-ffmpeg).
+
+``write_frames`` takes any iterable of H×W×3 or H×W×4 uint8 arrays, so the 2D renderer,
+the 3D viewport and the GUI export dialog all share it. Formats by ``out``:
+
+* an existing folder, or a path without a suffix: ``out/frame_0000.png`` …;
+* a pattern with a ``%`` field such as ``shots/frame_%04d.png``;
+* ``*.gif`` (looping, transparency flattened onto white);
+* ``*.mp4`` / ``*.mov`` / ``*.mkv`` / ``*.webm`` / ``*.avi`` (H.264 or the container's
+  default codec, odd sizes padded to even, transparency flattened onto white).
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterable
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+VIDEO_SUFFIXES = {".mp4": "libx264", ".mov": "libx264", ".mkv": "libx264", ".avi": "mpeg4",
+                  ".webm": "libvpx-vp9"}
+IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}
+
+Frame = npt.NDArray[np.uint8]
+
+
+def output_kind(out: str | os.PathLike[str]) -> str:
+    """``folder``, ``pattern``, ``gif`` or ``video`` for an output path."""
+    s = os.fspath(out)
+    suffix = Path(s).suffix.lower()
+    if "%" in Path(s).name:
+        return "pattern"
+    if suffix == ".gif":
+        return "gif"
+    if suffix in VIDEO_SUFFIXES:
+        return "video"
+    if suffix in IMAGE_SUFFIXES:
+        raise ValueError(f"'{s}' names one image; give a folder or a pattern such as frame_%04d.png")
+    return "folder"
+
+
+def _check_frame(frame: npt.ArrayLike, shape: tuple[int, ...] | None) -> Frame:
+    a = np.asarray(frame)
+    if a.dtype != np.uint8 or a.ndim != 3 or a.shape[2] not in (3, 4):
+        raise ValueError("frames must be H×W×3 or H×W×4 uint8 arrays")
+    if shape is not None and a.shape[:2] != shape[:2]:
+        raise ValueError("all frames must have the same size")
+    return a
+
+
+def flatten_alpha(frame: Frame, background: tuple[int, int, int] = (255, 255, 255)) -> Frame:
+    """An RGB copy of an RGBA frame composited over ``background``."""
+    if frame.shape[2] == 3:
+        return frame
+    rgb = frame[..., :3].astype(np.float32)
+    a = frame[..., 3:4].astype(np.float32) / 255.0
+    bg = np.asarray(background, dtype=np.float32)
+    return np.asarray(np.clip(rgb * a + bg * (1 - a) + 0.5, 0, 255), dtype=np.uint8)
+
+
+def _even(frame: Frame) -> Frame:
+    h, w = frame.shape[:2]
+    if h % 2 == 0 and w % 2 == 0:
+        return frame
+    return np.pad(frame, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
+
+
+def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], fps: float,
+                 progress: Callable[[int], None] | None = None,
+                 cancel: Callable[[], bool] | None = None, start: int = 0) -> int:
+    """Write ``frames`` to ``out`` at ``fps``; returns the number of frames written.
+
+    ``progress(n)`` is called after each frame; ``cancel()`` returning True stops early
+    (what was written stays). ``start`` is the number of the first file of a sequence.
+    """
+    if not (fps > 0):
+        raise ValueError("fps must be positive")
+    kind = output_kind(out)
+    path = os.fspath(out)
+    count = 0
+    if kind in ("folder", "pattern"):
+        import imageio.v3 as iio
+
+        if kind == "folder":
+            os.makedirs(path, exist_ok=True)
+            pattern = os.path.join(path, "frame_%04d.png")
+        else:
+            pattern = path
+            parent = os.path.dirname(path)
+            if parent:
+                os.makedirs(parent, exist_ok=True)
+        shape = None
+        for frame in frames:
+            if cancel is not None and cancel():
+                break
+            a = _check_frame(frame, shape)
+            shape = a.shape
+            iio.imwrite(pattern % (start + count), a)
+            count += 1
+            if progress is not None:
+                progress(count)
+        return count
+    parent = os.path.dirname(os.path.abspath(path))
+    os.makedirs(parent, exist_ok=True)
+    if kind == "gif":
+        from PIL import Image
+
+        images: list[Image.Image] = []
+        shape = None
+        for frame in frames:
+            if cancel is not None and cancel():
+                break
+            a = _check_frame(frame, shape)
+            shape = a.shape
+            images.append(Image.fromarray(flatten_alpha(a)).convert("P", palette=Image.Palette.ADAPTIVE))
+            count += 1
+            if progress is not None:
+                progress(count)
+        if images:
+            images[0].save(path, save_all=True, append_images=images[1:], loop=0,
+                           duration=max(int(round(1000.0 / fps)), 10), optimize=False)
+        return count
+    import imageio.v2 as iio2
+
+    codec = VIDEO_SUFFIXES[Path(path).suffix.lower()]
+    writer = None
+    shape = None
+    try:
+        for frame in frames:
+            if cancel is not None and cancel():
+                break
+            a = _check_frame(frame, shape)
+            shape = a.shape
+            if writer is None:
+                writer = iio2.get_writer(path, format="FFMPEG", mode="I", fps=float(fps), codec=codec,
+                                         macro_block_size=1, quality=8, pixelformat="yuv420p",
+                                         output_params=["-movflags", "+faststart"] if codec == "libx264" else None)
+            writer.append_data(_even(flatten_alpha(a)))
+            count += 1
+            if progress is not None:
+                progress(count)
+    finally:
+        if writer is not None:
+            writer.close()
+    return count
+
+
+def count_video_frames(path: str | os.PathLike[str]) -> int:
+    """The number of frames in a video or GIF file (decoded, not from the header)."""
+    p = os.fspath(path)
+    if Path(p).suffix.lower() == ".gif":
+        from PIL import Image
+
+        with Image.open(p) as im:
+            return int(getattr(im, "n_frames", 1))
+    import imageio.v2 as iio2
+
+    reader = iio2.get_reader(p, format="FFMPEG")
+    try:
+        n = 0
+        for _ in reader:
+            n += 1
+        return n
+    finally:
+        reader.close()

@@ -1,0 +1,57 @@
+"""The two coloured point lights and the ambient term, stored as document parameters.
+
+``light1.position`` / ``light1.color`` / ``light1.intensity`` (and ``light2.*``, and
+``lights.ambient``) are ordinary parameters changed with ``SetParameter`` commands, so they
+are saved with the project and undoable. Missing parameters take the defaults below.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+LIGHT_NAMES = ("light1", "light2")
+AMBIENT_PARAMETER = "lights.ambient"
+
+DEFAULTS: dict[str, Any] = {
+    "light1.position": [4.0, 6.0, 5.0],
+    "light1.color": [1.0, 0.95, 0.85],
+    "light1.intensity": 0.8,
+    "light2.position": [-5.0, 3.0, -3.0],
+    "light2.color": [0.55, 0.65, 1.0],
+    "light2.intensity": 0.5,
+    AMBIENT_PARAMETER: [0.16, 0.16, 0.18],
+}
+
+
+@dataclass
+class Light:
+    position: np.ndarray
+    color: np.ndarray
+    intensity: float
+
+    @property
+    def radiance(self) -> np.ndarray:
+        return self.color * self.intensity
+
+
+def parameter(doc: Any, path: str) -> Any:
+    """A light parameter of ``doc`` (or of a plain dict), falling back to its default."""
+    params = doc if isinstance(doc, dict) else doc.parameters
+    value = params.get(path)
+    return DEFAULTS[path] if value is None else value
+
+
+def lights_of(doc: Any) -> list[Light]:
+    out = []
+    for name in LIGHT_NAMES:
+        out.append(Light(np.asarray(parameter(doc, f"{name}.position"), dtype=float).reshape(3),
+                         np.clip(np.asarray(parameter(doc, f"{name}.color"), dtype=float).reshape(3), 0, 1),
+                         max(float(parameter(doc, f"{name}.intensity")), 0.0)))
+    return out
+
+
+def ambient_of(doc: Any) -> np.ndarray:
+    return np.asarray(parameter(doc, AMBIENT_PARAMETER), dtype=float).reshape(3)

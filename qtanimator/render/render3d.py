@@ -1,0 +1,176 @@
+"""Headless 3D rendering through an offscreen OpenGL context.
+
+``render_frames_3d(doc, times, size)`` yields one RGBA image (H×W×4 uint8) per time, drawn by
+the same :class:`~qtanimator.render.gl.renderer.SceneRenderer` as the viewport into a
+multisampled framebuffer object of a ``QOffscreenSurface`` + ``QOpenGLContext``.
+
+Without a display, the first call starts a private ``Xvfb`` (Mesa gives a GL 4.5 core context
+there); Qt's ``offscreen`` platform has no OpenGL.
+"""
+
+from __future__ import annotations
+
+import atexit
+import copy
+import os
+import shutil
+import subprocess
+from collections.abc import Iterable, Iterator
+from typing import Any
+
+import numpy as np
+from PySide6.QtGui import QGuiApplication, QImage, QOffscreenSurface, QOpenGLContext
+from PySide6.QtOpenGL import QOpenGLFramebufferObject, QOpenGLFramebufferObjectFormat
+
+from qtanimator.render.gl import surface_format
+from qtanimator.render.gl.camera import OrbitCamera
+from qtanimator.render.gl.lights import ambient_of, lights_of
+from qtanimator.render.gl.renderer import SceneItem, SceneRenderer, ViewOptions, grid_scale_for
+from qtanimator.render.scene3d import scene_bounds, scene_items
+
+
+class GLUnavailableError(OSError):
+    """No OpenGL 3.3 context can be made here; the message says why."""
+
+
+_xvfb: subprocess.Popen[bytes] | None = None
+
+
+def _start_private_xvfb() -> str:
+    global _xvfb
+    exe = shutil.which("Xvfb")
+    if exe is None:
+        raise GLUnavailableError("3D rendering needs a display or Xvfb (apt-get install xvfb)")
+    read_fd, write_fd = os.pipe()
+    _xvfb = subprocess.Popen([exe, "-displayfd", str(write_fd), "-screen", "0", "640x480x24",
+                              "-nolisten", "tcp", "+extension", "GLX", "-noreset"],
+                             pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    os.close(write_fd)
+    with os.fdopen(read_fd) as fh:
+        number = fh.readline().strip()
+    if not number:
+        _xvfb.kill()
+        raise GLUnavailableError("Xvfb started but reported no display")
+    atexit.register(_xvfb.terminate)
+    return f":{number}"
+
+
+def ensure_gui_application() -> QGuiApplication:
+    """The running QGuiApplication, or a new one (on a private Xvfb when there is no display)."""
+    app = QGuiApplication.instance()
+    if app is not None:
+        return app  # type: ignore[return-value]
+    platform = os.environ.get("QT_QPA_PLATFORM", "")
+    has_display = bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
+    if platform in ("", "offscreen", "minimal") and not has_display:
+        os.environ["DISPLAY"] = _start_private_xvfb()
+        os.environ["QT_QPA_PLATFORM"] = "xcb"
+    return QGuiApplication([])
+
+
+class OffscreenGL:
+    """An OpenGL 3.3 core context with a multisampled framebuffer of ``size`` pixels."""
+
+    def __init__(self, size: tuple[int, int], samples: int = 4) -> None:
+        ensure_gui_application()
+        self.context = QOpenGLContext()
+        self.context.setFormat(surface_format(samples))
+        if not self.context.create():
+            raise GLUnavailableError(
+                f"cannot create an OpenGL context on the '{QGuiApplication.platformName()}' platform "
+                "(3D rendering needs a display or Xvfb; qtanimator.render.render3d.ensure_gui_application() "
+                "starts a private Xvfb when it creates the application)")
+        fmt = self.context.format()
+        if (fmt.majorVersion(), fmt.minorVersion()) < (3, 3):
+            raise GLUnavailableError(f"OpenGL {fmt.majorVersion()}.{fmt.minorVersion()} < 3.3")
+        self.surface = QOffscreenSurface()
+        self.surface.setFormat(fmt)
+        self.surface.create()
+        self.samples = samples
+        self.fbo: QOpenGLFramebufferObject | None = None
+        self.make_current()
+        self.resize(size)
+
+    def make_current(self) -> None:
+        if not self.context.makeCurrent(self.surface):
+            raise GLUnavailableError("cannot make the offscreen OpenGL context current")
+
+    def resize(self, size: tuple[int, int]) -> None:
+        self.size = (int(size[0]), int(size[1]))
+        fmt = QOpenGLFramebufferObjectFormat()
+        fmt.setAttachment(QOpenGLFramebufferObject.Attachment.CombinedDepthStencil)
+        fmt.setSamples(self.samples)
+        self.fbo = QOpenGLFramebufferObject(self.size[0], self.size[1], fmt)
+        self.fbo.bind()
+
+    def bind(self) -> None:
+        assert self.fbo is not None
+        self.fbo.bind()
+
+    def read(self) -> np.ndarray:
+        """The framebuffer as an H×W×4 RGBA uint8 array (top row first)."""
+        assert self.fbo is not None
+        image = self.fbo.toImage().convertToFormat(QImage.Format.Format_RGBA8888)
+        return qimage_to_array(image)
+
+    def close(self) -> None:
+        if self.fbo is not None:
+            self.make_current()
+            self.fbo.release()
+            self.fbo = None
+        self.context.doneCurrent()
+
+
+def qimage_to_array(image: QImage) -> np.ndarray:
+    w, h = image.width(), image.height()
+    ptr = image.constBits()
+    arr = np.frombuffer(ptr, dtype=np.uint8, count=image.sizeInBytes()).reshape(h, image.bytesPerLine())
+    return arr[:, : w * 4].reshape(h, w, 4).copy()
+
+
+def default_camera(items: list[SceneItem], doc: Any = None) -> OrbitCamera:
+    """A camera framing the scene (or the one stored in the document's ``view3d.camera``)."""
+    cam = OrbitCamera()
+    stored = None if doc is None else doc.parameters.get("view3d.camera")
+    if isinstance(stored, dict):
+        cam.azimuth = float(stored.get("azimuth", cam.azimuth))
+        cam.inclination = float(stored.get("inclination", cam.inclination))
+        cam.distance = float(stored.get("distance", cam.distance))
+        cam.target = np.asarray(stored.get("target", [0, 0, 0]), dtype=float)
+        cam.fov_y = float(stored.get("fov_y", cam.fov_y))
+        return cam
+    bounds = scene_bounds(items)
+    if bounds is not None:
+        cam.frame(*bounds)
+    return cam
+
+
+def render_frames_3d(doc: Any, times: Iterable[float], size: tuple[int, int] = (640, 480),
+                     camera: OrbitCamera | None = None, options: ViewOptions | None = None,
+                     extra_items: Iterable[SceneItem] = ()) -> Iterator[np.ndarray]:
+    """Render the document's 3D scene at each time (seconds) into H×W×4 uint8 RGBA arrays.
+
+    The camera frames the scene at the first time unless one is given (or stored in the
+    document as ``view3d.camera``). By default skins are drawn without their skeleton and
+    without the light markers (``options`` changes that).
+    """
+    options = ViewOptions(show_skeleton=False, show_lights=False) if options is None else copy.copy(options)
+    gl = OffscreenGL(size)
+    renderer = SceneRenderer()
+    extra = list(extra_items)
+    try:
+        for t in times:
+            items = scene_items(doc, float(t)) + extra
+            if camera is None:
+                camera = default_camera(items, doc)
+                bounds = scene_bounds(items)
+                if bounds is not None:
+                    options.grid_scale = grid_scale_for(*bounds)
+            gl.make_current()
+            gl.bind()
+            renderer.render(items, camera, size[0], size[1], lights_of(doc), ambient_of(doc), options)
+            yield gl.read()
+    finally:
+        gl.make_current()
+        renderer.release()
+        gl.close()

@@ -1,0 +1,221 @@
+"""What the 3D view shows at a time, as plain draw data built from the document.
+
+``scene_items(doc, time)`` turns every 3D asset (characters with skeleton and skin, cloths)
+into :mod:`qtanimator.render.gl.renderer` draw items. It reads the document through the
+engines' public functions and never touches GL, so the viewport, the headless renderer and
+picking share it.
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterable
+from typing import Any
+
+import numpy as np
+
+from qtanimator.render.gl.meshes import csr_influences
+from qtanimator.render.gl.renderer import CharacterDraw, ClothDraw, PlaneDraw, SceneItem, SkinDraw
+
+CHARACTER_KIND = "character3d"
+CLOTH_KIND = "cloth"
+
+
+def _character3d() -> Any:
+    try:
+        from qtanimator.document import character3d
+    except ImportError:
+        return None
+    return character3d
+
+
+def _cloth_doc() -> Any:
+    try:
+        from qtanimator.document import cloth
+    except ImportError:
+        return None
+    return cloth
+
+
+def scene_items(doc: Any, time: float, selection: tuple[str, str] = ("", ""),
+                cloth_override: dict[str, Any] | None = None,
+                errors: list[str] | None = None) -> list[SceneItem]:
+    """Draw items for every 3D asset of ``doc`` at ``time`` seconds.
+
+    ``cloth_override`` maps a cloth asset id to a live ``Cloth`` simulation to show instead
+    of the document's cached state (the viewport's interactive cloth). With an ``errors``
+    list, an asset that cannot be evaluated is left out and its error appended there
+    (the viewport keeps drawing the rest); without it the error propagates.
+    """
+    items: list[SceneItem] = []
+    for asset_id, asset in doc.assets.items():
+        try:
+            if asset.kind == CHARACTER_KIND:
+                item = character_item(doc, asset_id, time, selection)
+                if item is not None:
+                    items.append(item)
+            elif asset.kind == CLOTH_KIND:
+                live = (cloth_override or {}).get(asset_id)
+                citem = cloth_item(doc, asset_id, time, live)
+                if citem is not None:
+                    items.append(citem)
+        except Exception as exc:
+            if errors is None:
+                raise
+            errors.append(f"{asset_id}: {type(exc).__name__}: {exc}")
+    return items
+
+
+def character_item(doc: Any, asset_id: str, time: float,
+                   selection: tuple[str, str] = ("", "")) -> CharacterDraw | None:
+    mod = _character3d()
+    if mod is None:
+        return None
+    skel = mod.pose_skeleton(doc, asset_id, time)
+    world = np.asarray(skel.world_matrices(), dtype=float)
+    selected = None
+    if selection[0] == asset_id and selection[1]:
+        with contextlib.suppress(KeyError, ValueError):
+            selected = joint_index(skel, selection[1])
+    has_boxes = draws_boxes(skel)
+    item = CharacterDraw(asset_id, world, skel.parents, selected=selected,
+                         joint_radius=joint_radius(skel, world))
+    if has_boxes:
+        item.boxmin = np.array([j.boxmin for j in skel.joints])
+        item.boxmax = np.array([j.boxmax for j in skel.joints])
+    item.skin = skin_draw(doc, asset_id, world)
+    return item
+
+
+def draws_boxes(skel: Any) -> bool:
+    """Balljoint skeletons with boxes draw them; others (MIT, BVH, no boxes) draw spheres and bones."""
+    from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN
+
+    if skel.rotation_order != "zyx" or not skel.joints:
+        return False
+    return any(not (np.allclose(j.boxmin, DEFAULT_BOXMIN) and np.allclose(j.boxmax, DEFAULT_BOXMAX))
+               for j in skel.joints)
+
+
+def joint_index(skel: Any, key: str) -> int:
+    """Index of a joint by its stable key (``name`` or ``name#index``)."""
+    keys = skel.joint_keys()
+    if key in keys:
+        return keys.index(key)
+    return int(skel.index_of(key))
+
+
+def joint_radius(skel: Any, world: np.ndarray) -> float:
+    """Sphere radius for drawing joints: a small fraction of the skeleton's size."""
+    pos = world[:, :3, 3]
+    if len(pos) < 2:
+        return 0.05
+    extent = float(np.linalg.norm(pos.max(axis=0) - pos.min(axis=0)))
+    return max(extent * 0.022, 1e-3)
+
+
+def skin_draw(doc: Any, asset_id: str, world: np.ndarray) -> SkinDraw | None:
+    """The skin of a character as bind data plus this pose's skinning matrices."""
+    runtime = doc.runtime.get(asset_id)
+    skin = getattr(runtime, "skin", None)
+    if skin is None:
+        return None
+    arrays = gpu_skin_arrays(skin)
+    faceted = bool(getattr(runtime, "faceted", False)) or arrays["faceted"]
+    inv = arrays["inverse_bind"]
+    n = min(len(world), len(inv))
+    matrices = np.tile(np.eye(4), (len(inv), 1, 1))
+    matrices[:n] = world[:n] @ inv[:n]
+    return SkinDraw(key=skin, positions=arrays["positions"], normals=arrays["normals"],
+                    triangles=arrays["triangles"], influence=arrays["influence"], pairs=arrays["pairs"],
+                    matrices=matrices, faceted=faceted)
+
+
+def gpu_skin_arrays(skin: Any) -> dict[str, Any]:
+    """Bind positions, normals, triangles, sparse influences and inverse bind matrices of a
+    :class:`qtanimator.core.skinning.Skin`, computed once per skin and kept in its extras."""
+    extras = getattr(skin, "extras", None)
+    cached = extras.get("_gpu_arrays") if isinstance(extras, dict) else None
+    if cached is not None:
+        return cached  # type: ignore[no-any-return]
+    positions = np.asarray(skin.positions, dtype=float)
+    normals = skin.normals
+    normals = None if normals is None or len(normals) != len(positions) else np.asarray(normals, dtype=float)
+    indptr, joints, weights = skin.binding.csr()
+    influence, pairs = csr_influences(indptr, joints, weights)
+    faceted = normals is None
+    out = {"positions": positions, "normals": normals, "triangles": np.asarray(skin.triangles, dtype=np.int64),
+           "influence": influence, "pairs": pairs,
+           "inverse_bind": np.asarray(skin.inverse_bind_matrices, dtype=float), "faceted": faceted}
+    if isinstance(extras, dict):
+        extras["_gpu_arrays"] = out
+    return out
+
+
+def cloth_item(doc: Any, asset_id: str, time: float, live: Any = None) -> ClothDraw | None:
+    """A cloth asset: the live simulation ``live`` when given, else the document's cached
+    simulation at the frame of ``time``."""
+    if live is not None:
+        positions = np.asarray(live.positions, dtype=float)
+        normals = np.asarray(live.normals(), dtype=float)
+        triangles, params, pinned = live.triangles, live.params, live.pinned
+    else:
+        mod = _cloth_doc()
+        if mod is None:
+            return None
+        cache = mod.cloth_cache(doc, asset_id)
+        positions = np.asarray(cache.positions(doc.time_to_frame(time)), dtype=float)
+        triangles, params, pinned = cache.triangles, cache.params, cache.cloth.pinned
+        normals = smooth_normals(positions, np.asarray(triangles, dtype=np.int64))
+    item = ClothDraw(asset_id, positions, normals, np.asarray(triangles, dtype=np.int64))
+    for s in getattr(params, "spheres", None) or []:
+        item.spheres.append((np.asarray(s[0], dtype=float), float(s[1])))
+    if pinned is not None:
+        idx = np.asarray(pinned)
+        if idx.dtype == bool:
+            idx = np.nonzero(idx)[0]
+        if idx.size:
+            item.pinned = positions[idx.astype(np.int64)]
+    return item
+
+
+def smooth_normals(positions: np.ndarray, triangles: np.ndarray) -> np.ndarray:
+    """Area-weighted vertex normals (zero-area triangles add nothing)."""
+    from qtanimator.core.skinning import vertex_normals
+
+    return vertex_normals(positions, triangles)
+
+
+def scene_bounds(items: Iterable[SceneItem]) -> tuple[np.ndarray, np.ndarray] | None:
+    """Axis-aligned bounds of everything drawn (None for an empty scene)."""
+    pts: list[np.ndarray] = []
+    for item in items:
+        if isinstance(item, CharacterDraw):
+            pts.append(item.world[:, :3, 3])
+            if item.skin is not None:
+                pts.append(skinned_positions(item.skin, 500))
+        elif isinstance(item, ClothDraw):
+            pts.append(item.positions)
+        elif isinstance(item, PlaneDraw):
+            s = item.size / 2
+            pts.append(np.array([[-s, item.height, -s], [s, item.height, s]]))
+    if not pts:
+        return None
+    allp = np.concatenate(pts)
+    return allp.min(axis=0), allp.max(axis=0)
+
+
+def skinned_positions(skin: SkinDraw, max_vertices: int | None = None) -> np.ndarray:
+    """CPU linear blend skinning of (a subsample of) a skin's vertices, for bounds and tests."""
+    step = 1 if max_vertices is None else max(1, len(skin.positions) // max_vertices)
+    idx = np.arange(0, len(skin.positions), step)
+    out = np.zeros((len(idx), 3))
+    first = skin.influence[idx, 0].astype(np.int64)
+    count = skin.influence[idx, 1].astype(np.int64)
+    h = np.c_[skin.positions[idx], np.ones(len(idx))]
+    for k in range(int(count.max()) if len(count) else 0):
+        has = count > k
+        jw = skin.pairs[first[has] + k]
+        m = skin.matrices[jw[:, 0].astype(np.int64)]
+        out[has] += jw[:, 1:2] * np.einsum("nab,nb->na", m, h[has])[:, :3]
+    return out

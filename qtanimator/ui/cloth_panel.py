@@ -1,0 +1,355 @@
+"""The cloth dock (``clothDock``): every :class:`~qtanimator.core.cloth.ClothParams` field of
+the selected cloth asset, edited live through ``set_cloth_param_command`` (a drag on a field
+is one undo step), plus the interactive simulation controls of the 3D viewport (live
+simulation on / off, pause, reset; W/A/S/D/Q/E and Z/C in the viewport move the pins)."""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import fields
+from typing import Any
+
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QHBoxLayout,
+    QLabel,
+    QLineEdit,
+    QPushButton,
+    QScrollArea,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
+
+from qtanimator.core.cloth import INTEGRATORS, PIN_MODES, ClothParams, Sphere
+from qtanimator.document.cloth import ASSET_KIND, add_cloth_command, cloth_params, set_cloth_param_command
+from qtanimator.ui.context import EditorContext
+
+_gestures = itertools.count(1)
+
+#: (minimum, maximum, step, decimals) of the float fields.
+FLOAT_RANGES: dict[str, tuple[float, float, float, int]] = {
+    "width": (0.01, 100.0, 0.1, 3), "height": (0.01, 100.0, 0.1, 3),
+    "total_mass": (0.001, 1000.0, 0.1, 3),
+    "structural_stiffness": (0.0, 1e6, 10.0, 2), "structural_damping": (0.0, 1e4, 0.05, 3),
+    "shear_stiffness": (0.0, 1e6, 10.0, 2), "shear_damping": (0.0, 1e4, 0.05, 3),
+    "bend_stiffness": (0.0, 1e6, 1.0, 2), "bend_damping": (0.0, 1e4, 0.01, 3),
+    "drag_coefficient": (0.0, 10.0, 0.05, 3), "air_density": (0.0, 2000.0, 0.05, 3),
+    "turbulence": (0.0, 100.0, 0.1, 3), "gravity": (-100.0, 100.0, 0.1, 3),
+    "ground_height": (-100.0, 100.0, 0.05, 3), "ground_restitution": (0.0, 1.0, 0.05, 3),
+    "ground_friction": (0.0, 1.0, 0.05, 3), "collision_margin": (0.0, 1.0, 0.001, 4),
+}
+INT_RANGES: dict[str, tuple[int, int]] = {"rows": (2, 200), "cols": (2, 200), "turbulence_seed": (0, 2**31 - 1),
+                                          "substeps": (1, 1000)}
+CHOICES: dict[str, tuple[str, ...]] = {"pin_mode": PIN_MODES, "integrator": INTEGRATORS}
+VECTORS = ("wind", "origin", "orientation")
+GROUPS = (
+    ("Grid", ("rows", "cols", "width", "height", "total_mass", "origin", "orientation")),
+    ("Springs", ("structural_stiffness", "structural_damping", "shear_stiffness", "shear_damping",
+                 "bend_stiffness", "bend_damping")),
+    ("Air and wind", ("drag_coefficient", "air_density", "wind", "turbulence", "turbulence_seed", "gravity")),
+    ("Collisions", ("ground_enabled", "ground_height", "ground_restitution", "ground_friction", "spheres",
+                    "collision_margin")),
+    ("Pins and solver", ("pin_mode", "custom_pins", "integrator", "substeps")),
+)
+
+
+def _label(name: str) -> str:
+    return name.replace("_", " ").capitalize()
+
+
+class ClothPanel(QWidget):
+    def __init__(self, ctx: EditorContext, window: Any = None, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("clothPanel")
+        self.ctx = ctx
+        self.window_ = window
+        self.editors: dict[str, Any] = {}
+        self._updating = False
+        self._gesture: tuple[str, int] | None = None
+        outer = QVBoxLayout(self)
+        top = QHBoxLayout()
+        self.asset = QComboBox(self)
+        self.asset.setObjectName("clothAsset")
+        self.asset.currentIndexChanged.connect(self._on_asset_changed)
+        add = QPushButton("Add cloth", self)
+        add.setObjectName("clothAdd")
+        add.clicked.connect(self.add_cloth)
+        top.addWidget(self.asset, 1)
+        top.addWidget(add)
+        outer.addLayout(top)
+        sim = QHBoxLayout()
+        self.live = QCheckBox("Interactive", self)
+        self.live.setObjectName("clothLive")
+        self.live.setToolTip("Simulate in real time in the 3D view: W/A/S/D/Q/E move the pins, Z/C turn them, "
+                             "drag the cloth with the mouse")
+        self.live.toggled.connect(self._on_live)
+        self.pause = QPushButton("Pause", self)
+        self.pause.setObjectName("clothPause")
+        self.pause.setCheckable(True)
+        self.pause.toggled.connect(self._on_pause)
+        self.reset = QPushButton("Reset", self)
+        self.reset.setObjectName("clothReset")
+        self.reset.clicked.connect(self._on_reset)
+        for w in (self.live, self.pause, self.reset):
+            sim.addWidget(w)
+        outer.addLayout(sim)
+        self.message = QLabel(self)
+        self.message.setObjectName("clothMessage")
+        self.message.setWordWrap(True)
+        outer.addWidget(self.message)
+
+        body = QWidget(self)
+        form_layout = QVBoxLayout(body)
+        for title, names in GROUPS:
+            head = QLabel(f"<b>{title}</b>", body)
+            form_layout.addWidget(head)
+            form = QFormLayout()
+            for name in names:
+                form.addRow(_label(name), self._make_editor(name, body))
+            form_layout.addLayout(form)
+        form_layout.addStretch(1)
+        scroll = QScrollArea(self)
+        scroll.setWidgetResizable(True)
+        scroll.setWidget(body)
+        outer.addWidget(scroll, 1)
+        known = {f.name for f in fields(ClothParams)}
+        missing = known - set(self.editors)
+        assert not missing, f"cloth fields without an editor: {missing}"
+        scroll.setMinimumHeight(220)
+        ctx.documentChanged.connect(self._on_changed)
+        ctx.documentReset.connect(self.refresh_assets)
+        vp = self._viewport()
+        if vp is not None:
+            vp.liveClothChanged.connect(self._show_live)
+        self.refresh_assets()
+
+    def _show_live(self, on: bool) -> None:
+        self.live.blockSignals(True)
+        self.live.setChecked(on)
+        self.live.blockSignals(False)
+
+    # ------------------------------------------------------------- editors
+    def _spin(self, name: str, parent: QWidget, lo: float, hi: float, step: float, decimals: int) -> QDoubleSpinBox:
+        s = QDoubleSpinBox(parent)
+        s.setRange(lo, hi)
+        s.setSingleStep(step)
+        s.setDecimals(decimals)
+        s.setObjectName(f"cloth_{name}")
+        return s
+
+    def _make_editor(self, name: str, parent: QWidget) -> QWidget:
+        if name in FLOAT_RANGES:
+            s = self._spin(name, parent, *FLOAT_RANGES[name])
+            s.valueChanged.connect(lambda v, n=name: self.edit(n, float(v)))
+            self.editors[name] = s
+            return s
+        if name in INT_RANGES:
+            i = QSpinBox(parent)
+            i.setObjectName(f"cloth_{name}")
+            i.setRange(*INT_RANGES[name])
+            i.valueChanged.connect(lambda v, n=name: self.edit(n, int(v)))
+            self.editors[name] = i
+            return i
+        if name in CHOICES:
+            c = QComboBox(parent)
+            c.setObjectName(f"cloth_{name}")
+            c.addItems(list(CHOICES[name]))
+            c.currentTextChanged.connect(lambda v, n=name: self.edit(n, str(v)))
+            self.editors[name] = c
+            return c
+        if name == "ground_enabled":
+            b = QCheckBox(parent)
+            b.setObjectName("cloth_ground_enabled")
+            b.toggled.connect(lambda v: self.edit("ground_enabled", bool(v)))
+            self.editors[name] = b
+            return b
+        if name in VECTORS:
+            w = QWidget(parent)
+            row = QHBoxLayout(w)
+            row.setContentsMargins(0, 0, 0, 0)
+            spins = []
+            lim = 1000.0 if name != "orientation" else 2 * math.pi
+            for axis in "xyz":
+                s = self._spin(f"{name}_{axis}", w, -lim, lim, 0.1, 3)
+                s.valueChanged.connect(lambda _v, n=name: self._vector_edited(n))
+                row.addWidget(s)
+                spins.append(s)
+            self.editors[name] = spins
+            if name == "wind":
+                speed = self._spin("wind_speed", w, 0.0, 1000.0, 0.5, 2)
+                speed.setPrefix("speed ")
+                speed.valueChanged.connect(self._speed_edited)
+                row.addWidget(speed)
+                self.wind_speed = speed
+            return w
+        if name == "spheres":
+            w = QWidget(parent)
+            row = QHBoxLayout(w)
+            row.setContentsMargins(0, 0, 0, 0)
+            on = QCheckBox("on", w)
+            on.setObjectName("cloth_sphere_on")
+            spins = [self._spin(f"sphere_{k}", w, -1000.0, 1000.0, 0.05, 3) for k in ("x", "y", "z", "radius")]
+            spins[3].setRange(0.001, 1000.0)
+            on.toggled.connect(lambda _v: self._sphere_edited())
+            row.addWidget(on)
+            for s in spins:
+                s.valueChanged.connect(lambda _v: self._sphere_edited())
+                row.addWidget(s)
+            self.editors[name] = (on, spins)
+            return w
+        if name == "custom_pins":
+            e = QLineEdit(parent)
+            e.setObjectName("cloth_custom_pins")
+            e.setPlaceholderText("particle indices, e.g. 0 19")
+            e.editingFinished.connect(self._pins_edited)
+            self.editors[name] = e
+            return e
+        raise ValueError(name)
+
+    # ------------------------------------------------------------- editing
+    def current_asset(self) -> str:
+        return str(self.asset.currentData() or "")
+
+    def edit(self, name: str, value: Any) -> bool:
+        """Set one parameter of the current cloth through a command. False if refused."""
+        asset = self.current_asset()
+        if self._updating or not asset:
+            return False
+        if self._gesture is None or self._gesture[0] != name:
+            self._gesture = (name, next(_gestures))
+        try:
+            cmd = set_cloth_param_command(self.ctx.doc, asset, name, value, gesture=("cloth", asset, self._gesture))
+        except ValueError as exc:
+            self.message.setText(str(exc))
+            self.refresh_fields()
+            return False
+        self.message.setText("")
+        self.ctx.push(cmd)
+        return True
+
+    def _vector_edited(self, name: str) -> None:
+        self.edit(name, [float(s.value()) for s in self.editors[name]])
+        if name == "wind":
+            self._show_speed()
+
+    def _speed_edited(self, speed: float) -> None:
+        if self._updating:
+            return
+        v = [float(s.value()) for s in self.editors["wind"]]
+        length = math.sqrt(sum(c * c for c in v))
+        direction = [c / length for c in v] if length > 1e-9 else [1.0, 0.0, 0.0]
+        self.edit("wind", [round(c * speed, 6) for c in direction])
+        self.refresh_fields()
+
+    def _show_speed(self) -> None:
+        v = [float(s.value()) for s in self.editors["wind"]]
+        self._updating = True
+        self.wind_speed.setValue(math.sqrt(sum(c * c for c in v)))
+        self._updating = False
+
+    def _sphere_edited(self) -> None:
+        on, spins = self.editors["spheres"]
+        spheres = []
+        if on.isChecked():
+            x, y, z, r = (float(s.value()) for s in spins)
+            spheres = [Sphere((x, y, z), r).to_dict()]
+        self.edit("spheres", spheres)
+
+    def _pins_edited(self) -> None:
+        text = self.editors["custom_pins"].text().replace(",", " ")
+        try:
+            pins = [int(t) for t in text.split()]
+        except ValueError:
+            self.message.setText("Custom pins are particle numbers separated by spaces.")
+            return
+        self.edit("custom_pins", pins)
+
+    def _on_asset_changed(self, _index: int) -> None:
+        self._gesture = None
+        self.refresh_fields()
+
+    def add_cloth(self) -> None:
+        self.ctx.push(add_cloth_command(self.ctx.doc))
+
+    # ------------------------------------------------------------ refresh
+    def _on_changed(self, event: Any) -> None:
+        if event.kind == "asset":
+            self.refresh_assets()
+
+    def refresh_assets(self) -> None:
+        current = self.current_asset()
+        ids = [a for a, asset in self.ctx.doc.assets.items() if asset.kind == ASSET_KIND]
+        self.asset.blockSignals(True)
+        self.asset.clear()
+        for a in ids:
+            self.asset.addItem(a, a)
+        if current in ids:
+            self.asset.setCurrentIndex(ids.index(current))
+        self.asset.blockSignals(False)
+        self.refresh_fields()
+
+    def refresh_fields(self) -> None:
+        asset = self.current_asset()
+        enabled = bool(asset)
+        params = cloth_params(self.ctx.doc, asset) if asset else ClothParams()
+        self._updating = True
+        try:
+            for name, editor in self.editors.items():
+                value = getattr(params, name)
+                if name in FLOAT_RANGES or name in INT_RANGES:
+                    editor.setValue(value)
+                elif name in CHOICES:
+                    editor.setCurrentText(str(value))
+                elif name == "ground_enabled":
+                    editor.setChecked(bool(value))
+                elif name in VECTORS:
+                    for s, v in zip(editor, value):
+                        s.setValue(float(v))
+                elif name == "spheres":
+                    on, spins = editor
+                    on.setChecked(bool(value))
+                    if value:
+                        s0 = Sphere.from_value(value[0])
+                        for s, v in zip(spins, (*s0.centre, s0.radius)):
+                            s.setValue(float(v))
+                elif name == "custom_pins":
+                    editor.setText(" ".join(str(i) for i in value))
+            wind = params.wind
+            self.wind_speed.setValue(math.sqrt(sum(c * c for c in wind)))
+        finally:
+            self._updating = False
+        for w in self.findChildren(QWidget):
+            if w.objectName().startswith("cloth_"):
+                w.setEnabled(enabled)
+
+    # --------------------------------------------------- live simulation
+    def _viewport(self) -> Any:
+        return getattr(self.window_, "viewport3d", None)
+
+    def _on_live(self, on: bool) -> None:
+        vp = self._viewport()
+        if vp is not None:
+            vp.set_live_cloth(on)
+
+    def _on_pause(self, paused: bool) -> None:
+        vp = self._viewport()
+        if vp is not None:
+            vp.live.paused = paused
+
+    def _on_reset(self) -> None:
+        vp = self._viewport()
+        if vp is not None:
+            vp.live.reset()
+            vp.update()
+
+
+def install(window: Any) -> None:
+    panel = ClothPanel(window.ctx, window, window)
+    window.cloth_panel = panel
+    window.add_dock("clothDock", "Cloth", panel, Qt.DockWidgetArea.RightDockWidgetArea)

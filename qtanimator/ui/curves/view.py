@@ -1,0 +1,856 @@
+"""The curve plot: channels against time in frames, keys, handles and their interaction.
+
+:class:`CurveView` owns the pyqtgraph plot (objectName ``curvePlot``), the per-channel
+curve items, the key selection and the gestures. Every edit is a command pushed with
+``ctx.push``; a drag pushes one command per mouse move with the same gesture token, so
+the undo stack merges the drag into one step, and Escape aborts it (the merged step is
+undone and removed from the stack).
+
+Mouse: left click selects a key (Shift adds / toggles), left drag on a key moves the
+selected keys (hold Shift once moving to lock to the main axis), Ctrl+drag on a key
+scales the selected keys in time about the current frame, drag on a handle sets a fixed
+slope, on empty space box-selects; Ctrl+click inserts a key on the curve under the
+cursor; middle drag or Alt+left drag pans; right drag zooms each axis; the wheel zooms
+(Ctrl: time only, Shift: values only); dragging the current-frame line scrubs.
+Keys: A frame all, F frame selected, N normalise, Delete removes selected keys, Ctrl+A
+selects all keys, Escape aborts a drag.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Callable, Hashable, Iterable
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pyqtgraph as pg
+from PySide6.QtCore import QEvent, QObject, QPointF, QRectF, Qt, Signal
+from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPen, QTransform
+from PySide6.QtWidgets import QGraphicsItem, QGraphicsRectItem, QWidget
+
+from qtanimator.core.channel import Channel, Key
+from qtanimator.document.commands import Command, DeleteKeys, InsertKey
+from qtanimator.document.curve_commands import MoveCurveKeys, SetKeySlopes
+from qtanimator.document.document import ChangeEvent, split_channel_id
+from qtanimator.ui.curves.items import (
+    HANDLE_SIZE,
+    ChannelDrawing,
+    CurveLayer,
+    KeyLayer,
+    channel_colour,
+    handle_offsets,
+    map_points,
+)
+from qtanimator.ui.curves.sampling import SampleCache
+
+_gesture_ids = itertools.count(1)
+PICK_RADIUS = 7.0       # pixels: how close a click must be to a key or handle
+CURVE_PICK_RADIUS = 8.0  # pixels: how close to a curve Ctrl+click must be
+BACKGROUND = QColor(38, 40, 44)
+
+
+@dataclass
+class _Drag:
+    kind: str                       # "keys", "scale", "handle", "box" or "aborted"
+    gesture: Hashable = None
+    pushed: bool = False
+    base: dict[str, Channel] = field(default_factory=dict)
+    selection: dict[str, list[int]] = field(default_factory=dict)
+    anchor: tuple[str, int] | None = None
+    side: str = ""
+    start_scene: QPointF = field(default_factory=QPointF)
+    additive: bool = False
+
+
+class FrameLine(pg.InfiniteLine):
+    """The current-frame line. It lets keys and handles under it take the mouse."""
+
+    def __init__(self, view: CurveView, **kw: Any) -> None:
+        super().__init__(**kw)
+        self._view = view
+
+    def _covers_key(self, scene: QPointF) -> bool:
+        return self._view.handle_at(scene) is not None or self._view.key_at(scene) is not None
+
+    def mouseDragEvent(self, ev: Any) -> None:
+        if ev.isStart() and self._covers_key(ev.buttonDownScenePos()):
+            ev.ignore()
+            return
+        super().mouseDragEvent(ev)
+
+    def mouseClickEvent(self, ev: Any) -> None:
+        if self._covers_key(ev.scenePos()):
+            ev.ignore()
+            return
+        super().mouseClickEvent(ev)
+
+
+class CurveViewBox(pg.ViewBox):
+    """A ViewBox whose left-button gestures edit keys; the rest zooms and pans."""
+
+    def __init__(self, view: CurveView) -> None:
+        super().__init__(enableMenu=False)
+        self._view = view
+
+    def mouseClickEvent(self, ev: Any) -> None:
+        if not self.sceneBoundingRect().contains(ev.scenePos()):
+            # A click forwarded by an axis: on the time axis it sets the current frame.
+            if ev.button() == Qt.MouseButton.LeftButton and ev.scenePos().y() > self.sceneBoundingRect().bottom():
+                ev.accept()
+                self._view.ctx.set_frame(float(round(self.mapSceneToView(ev.scenePos()).x())))
+            return
+        if ev.button() == Qt.MouseButton.LeftButton:
+            ev.accept()
+            self._view.click(ev.scenePos(), ev.modifiers())
+        elif ev.button() == Qt.MouseButton.RightButton:
+            ev.accept()
+            self._view.context_menu_requested.emit(ev.screenPos())
+        else:
+            super().mouseClickEvent(ev)
+
+    def mouseDragEvent(self, ev: Any, axis: int | None = None) -> None:
+        if axis is None and self._view.drag_event(ev):
+            return
+        super().mouseDragEvent(ev, axis)
+
+    def wheelEvent(self, ev: Any, axis: int | None = None) -> None:
+        if axis is None:
+            mods = ev.modifiers()
+            if mods & Qt.KeyboardModifier.ControlModifier:
+                axis = 0
+            elif mods & Qt.KeyboardModifier.ShiftModifier:
+                axis = 1
+        super().wheelEvent(ev, axis)
+
+
+class CurvePlot(pg.PlotWidget):
+    """The plot widget (objectName ``curvePlot``); keys go to the curve view first."""
+
+    def __init__(self, view: CurveView, parent: QWidget | None = None) -> None:
+        self._view = view
+        super().__init__(parent, background=BACKGROUND, viewBox=CurveViewBox(view))
+        self.setObjectName("curvePlot")
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+
+    def mousePressEvent(self, ev: QMouseEvent) -> None:
+        # pyqtgraph's drag events carry the modifiers of each move; Shift-to-add is decided
+        # by the modifiers held when the button went down.
+        self._view.press_modifiers = ev.modifiers()
+        super().mousePressEvent(ev)
+
+    def event(self, ev: QEvent) -> bool:
+        # Keys the curve editor uses win over window shortcuts while the plot has focus.
+        if ev.type() == QEvent.Type.ShortcutOverride and self._view.handles_key(ev):  # type: ignore[arg-type]
+            ev.accept()
+            return True
+        return super().event(ev)
+
+    def keyPressEvent(self, ev: QKeyEvent) -> None:
+        if self._view.key_press(ev):
+            ev.accept()
+            return
+        super().keyPressEvent(ev)
+
+
+class CurveView(QObject):
+    """Plot, items, selection and gestures of the curve editor."""
+
+    #: The key selection changed.
+    keySelectionChanged = Signal()
+    #: Right click at a screen position (QPointF): the editor shows its menu.
+    context_menu_requested = Signal(object)
+    #: Display-only normalisation was switched on or off.
+    normalisedChanged = Signal(bool)
+
+    def __init__(self, ctx: Any, parent: QObject | None = None) -> None:
+        super().__init__(parent)
+        self.ctx = ctx
+        self.cache = SampleCache()
+        self.visible: list[str] = []
+        self.highlighted: set[str] = set()
+        self.selection: dict[str, set[int]] = {}
+        self.active: tuple[str, int] | None = None
+        self.normalised = False
+        self.snap = True
+        self.axis_lock = "none"   # "none", "time" or "value"
+        self._frozen_norm: dict[str, tuple[float, float]] = {}
+        self._drag: _Drag | None = None
+        self._drawings: dict[str, ChannelDrawing] = {}
+        self._live: set[str] = set()
+        self._syncing_frame = False
+        self.press_modifiers = Qt.KeyboardModifier.NoModifier
+
+        self.widget = CurvePlot(self)
+        self.plot_item = self.widget.getPlotItem()
+        self.vb: CurveViewBox = self.plot_item.getViewBox()
+        self.vb.disableAutoRange()
+        self.plot_item.showGrid(x=True, y=True, alpha=0.15)
+        self.plot_item.setLabel("bottom", "frame")
+        self.plot_item.hideButtons()
+        self.plot_item.setMenuEnabled(False)
+        # The axes draw the grid across the whole view; keep their pixels between range
+        # changes instead of replaying their drawing for every redraw during a drag.
+        for name in ("left", "bottom"):
+            self.plot_item.getAxis(name).setCacheMode(QGraphicsItem.CacheMode.DeviceCoordinateCache)
+
+        # Channels not being edited are drawn by a cached layer; the ones with selected
+        # keys or under a drag by a live layer on top of it (see CurveLayer).
+        self.static_layer = CurveLayer(lambda: self._layer_drawings(False), cached=True)
+        self.live_layer = CurveLayer(lambda: self._layer_drawings(True), cached=False)
+        self.static_layer.setZValue(5)
+        self.live_layer.setZValue(10)
+        self.vb.addItem(self.static_layer, ignoreBounds=True)
+        self.vb.addItem(self.live_layer, ignoreBounds=True)
+        self.frame_line = FrameLine(self, pos=ctx.frame, angle=90, movable=True,
+                                          pen=pg.mkPen(QColor(80, 160, 255), width=2),
+                                          hoverPen=pg.mkPen(QColor(140, 200, 255), width=3))
+        self.frame_line.setZValue(20)
+        self.vb.addItem(self.frame_line, ignoreBounds=True)
+        self.frame_line.sigPositionChanged.connect(self._frame_line_moved)
+        self.box = QGraphicsRectItem()
+        self.box.setPen(QPen(QColor(255, 255, 255, 180), 0))
+        self.box.setBrush(QColor(255, 255, 255, 30))
+        self.box.setZValue(30)
+        self.box.hide()
+        self.vb.addItem(self.box, ignoreBounds=True)
+
+        ctx.frameChanged.connect(self._frame_changed)
+        ctx.documentChanged.connect(self._document_changed)
+        self.vb.sigRangeChanged.connect(lambda *_: self.refresh_all())
+        self.vb.sigResized.connect(lambda *_: self.refresh_all())
+        start, end = ctx.doc.frame_range
+        self.vb.setRange(xRange=(start, end), yRange=(-1, 1), padding=0.02)
+
+    # ------------------------------------------------------------ document
+    @property
+    def doc(self) -> Any:
+        return self.ctx.doc
+
+    @property
+    def fps(self) -> float:
+        return float(self.doc.fps)
+
+    def set_visible(self, cids: Iterable[str]) -> None:
+        """Plot exactly these channels (in this order)."""
+        wanted = [c for c in cids if c in self.doc.channels]
+        self.visible = wanted
+        for cid in set(self._drawings) - set(wanted):
+            del self._drawings[cid]
+        self._prune_selection()
+        self.refresh_all()
+
+    def set_highlighted(self, cids: Iterable[str]) -> None:
+        self.highlighted = set(cids)
+        self.static_layer.update()
+        self.live_layer.update()
+
+    def drawing(self, cid: str) -> ChannelDrawing | None:
+        """What is drawn for a visible channel (view coordinates)."""
+        return self._drawings.get(cid)
+
+    def set_normalised(self, on: bool) -> None:
+        if on != self.normalised:
+            self.normalised = on
+            self.refresh_all()
+            self.frame_all()
+            self.normalisedChanged.emit(on)
+
+    def display_transform(self, cid: str) -> tuple[float, float]:
+        """``(offset, scale)``: display value = (value − offset) · scale."""
+        frozen = self._frozen_norm.get(cid)
+        if frozen is not None:
+            return frozen
+        if not self.normalised:
+            return 0.0, 1.0
+        return self.cache.normalisation(cid, self.doc.channels[cid])
+
+    def _span(self) -> tuple[float, float, int]:
+        (x0, x1), _ = self.vb.viewRange()
+        width = max(64, min(2048, int(self.vb.width())))
+        return float(x0), float(x1), width
+
+    def refresh_channel(self, cid: str, update: bool = True) -> None:
+        """Resample (if its object or the view changed) and redraw one channel."""
+        ch = self.doc.channels.get(cid)
+        if ch is None or cid not in self.visible:
+            self._drawings.pop(cid, None)
+            return
+        x0, x1, n = self._span()
+        s = self.cache.get(cid, ch, self.fps, x0, x1, n)
+        off, scale = self.display_transform(cid)
+        if off == 0.0 and scale == 1.0:
+            y, ext_y = s.y, s.ext_y
+        else:
+            y, ext_y = (s.y - off) * scale, (s.ext_y - off) * scale
+        self._drawings[cid] = ChannelDrawing(cid, channel_colour(cid), s.x, y, s.ext_x, ext_y)
+        if update:
+            (self.live_layer if cid in self._live else self.static_layer).update()
+
+    def refresh_all(self) -> None:
+        for cid in self.visible:
+            self.refresh_channel(cid, update=False)
+        self._live = self._live_channels()
+        self.static_layer.update()
+        self.live_layer.update()
+
+    def _live_channels(self) -> set[str]:
+        live = {cid for cid, idx in self.selection.items() if idx}
+        if self._drag is not None:
+            live |= set(self._drag.base)
+        return live & set(self.visible)
+
+    def _update_live(self) -> None:
+        """Move channels between the cached and the live layer when the selection changes."""
+        live = self._live_channels()
+        if live != self._live:
+            self._live = live
+            self.static_layer.update()
+        self.live_layer.update()
+
+    def _document_changed(self, event: ChangeEvent) -> None:
+        if event.kind == "channel":
+            cid = event.key
+            if cid not in self.doc.channels:
+                self.cache.drop(cid)
+            self._prune_selection()
+            if cid in self.visible:
+                self.refresh_channel(cid)
+        elif event.kind == "parameter" and event.key == "fps":
+            self.refresh_all()
+
+    def _prune_selection(self) -> None:
+        changed = False
+        for cid in list(self.selection):
+            ch = self.doc.channels.get(cid)
+            if ch is None or cid not in self.visible:
+                del self.selection[cid]
+                changed = True
+                continue
+            keep = {i for i in self.selection[cid] if i < len(ch.keys)}
+            if keep != self.selection[cid]:
+                changed = True
+                if keep:
+                    self.selection[cid] = keep
+                else:
+                    del self.selection[cid]
+        if self.active is not None and self.active[1] not in self.selection.get(self.active[0], set()):
+            self.active = self._first_selected()
+            changed = True
+        if changed:
+            self.keySelectionChanged.emit()
+
+    def reset(self) -> None:
+        """The document was replaced: forget caches and selection."""
+        self.cache.clear()
+        self.selection.clear()
+        self.active = None
+        self._drag = None
+        self._frozen_norm.clear()
+        self._frame_changed(self.ctx.frame)
+        self.keySelectionChanged.emit()
+
+    # ------------------------------------------------------------- drawing
+    def _layer_drawings(self, live: bool) -> list[ChannelDrawing]:
+        """Drawings of the live or the cached layer, highlighted channels last (on top)."""
+        out = []
+        fps = self.fps
+        for cid in sorted(self.visible, key=lambda c: c in self.highlighted):
+            if (cid in self._live) != live:
+                continue
+            d = self._drawings.get(cid)
+            ch = self.doc.channels.get(cid)
+            if d is None or ch is None:
+                continue
+            d.highlighted = cid in self.highlighted
+            d.keys = None
+            if ch.keys:
+                off, scale = self.display_transform(cid)
+                sel_idx = sorted(self.selection.get(cid, ()))
+                mask = np.zeros(len(ch.keys), dtype=bool)
+                mask[sel_idx] = True
+                layer = KeyLayer(ch.times * fps, (ch.values - off) * scale, mask)
+                if sel_idx:
+                    s_in, s_out = ch.slopes()
+                    k = scale / fps
+                    layer.slope_in = s_in[sel_idx] * k
+                    layer.slope_out = s_out[sel_idx] * k
+                d.keys = layer
+            out.append(d)
+        return out
+
+    def view_to_scene(self) -> QTransform:
+        self.vb.updateMatrix()  # pyqtgraph defers it to the next paint after a range change
+        return self.vb.childGroup.sceneTransform()
+
+    # ------------------------------------------------------------ picking
+    def key_at(self, scene: QPointF, radius: float = PICK_RADIUS) -> tuple[str, int] | None:
+        tr = self.view_to_scene()
+        best: tuple[float, str, int] | None = None
+        fps = self.fps
+        for cid in self.visible:
+            ch = self.doc.channels.get(cid)
+            if ch is None or not ch.keys:
+                continue
+            off, scale = self.display_transform(cid)
+            px, py = map_points(tr, ch.times * fps, (ch.values - off) * scale)
+            d = np.hypot(px - scene.x(), py - scene.y())
+            i = int(np.argmin(d))
+            # Prefer selected keys when two overlap.
+            dist = float(d[i]) - (0.5 if i in self.selection.get(cid, ()) else 0.0)
+            if d[i] <= radius and (best is None or dist < best[0]):
+                best = (dist, cid, i)
+        return None if best is None else (best[1], best[2])
+
+    def handle_positions(self, cid: str, index: int) -> tuple[QPointF, QPointF, QPointF]:
+        """Scene positions of a key and its in and out handle ends."""
+        ch = self.doc.channels[cid]
+        off, scale = self.display_transform(cid)
+        tr = self.view_to_scene()
+        s_in, s_out = ch.slopes()
+        k = scale / self.fps
+        x = np.array([ch.keys[index].time * self.fps])
+        y = np.array([(ch.keys[index].value - off) * scale])
+        px, py = map_points(tr, x, y)
+        ox, oy = handle_offsets(tr, np.array([s_out[index] * k]))
+        ix, iy = handle_offsets(tr, np.array([s_in[index] * k]))
+        key = QPointF(px[0], py[0])
+        return key, QPointF(px[0] - ix[0], py[0] - iy[0]), QPointF(px[0] + ox[0], py[0] + oy[0])
+
+    def handle_at(self, scene: QPointF) -> tuple[str, int, str] | None:
+        best: tuple[float, str, int, str] | None = None
+        for cid, idx in self.selection.items():
+            if cid not in self.doc.channels:
+                continue
+            for i in idx:
+                _key, hin, hout = self.handle_positions(cid, i)
+                for side, h in (("in", hin), ("out", hout)):
+                    d = math.hypot(h.x() - scene.x(), h.y() - scene.y())
+                    if d <= max(PICK_RADIUS, HANDLE_SIZE) and (best is None or d < best[0]):
+                        best = (d, cid, i, side)
+        return None if best is None else (best[1], best[2], best[3])
+
+    def curve_at(self, scene: QPointF) -> str | None:
+        """The visible channel whose curve passes closest (vertically) to ``scene``."""
+        tr = self.view_to_scene()
+        view = self.vb.mapSceneToView(scene)
+        t = view.x() / self.fps
+        best: tuple[float, str] | None = None
+        for cid in self.visible:
+            ch = self.doc.channels.get(cid)
+            if ch is None or not ch.keys:
+                continue
+            off, scale = self.display_transform(cid)
+            y = (ch.evaluate(t) - off) * scale
+            _px, py = map_points(tr, np.array([view.x()]), np.array([y]))
+            d = abs(float(py[0]) - scene.y())
+            if d <= CURVE_PICK_RADIUS and (best is None or d < best[0]):
+                best = (d, cid)
+        return None if best is None else best[1]
+
+    # ---------------------------------------------------------- selection
+    def selected_keys(self) -> dict[str, list[int]]:
+        return {cid: sorted(idx) for cid, idx in self.selection.items() if idx}
+
+    def _first_selected(self) -> tuple[str, int] | None:
+        for cid in self.visible:
+            if self.selection.get(cid):
+                return cid, min(self.selection[cid])
+        return None
+
+    def set_selection(self, selection: dict[str, Iterable[int]], active: tuple[str, int] | None = None) -> None:
+        self.selection = {cid: set(idx) for cid, idx in selection.items() if idx}
+        if active is not None and active[1] in self.selection.get(active[0], set()):
+            self.active = active
+        elif self.active is None or self.active[1] not in self.selection.get(self.active[0], set()):
+            self.active = self._first_selected()
+        self._update_live()
+        self.keySelectionChanged.emit()
+
+    def clear_selection(self) -> None:
+        self.set_selection({})
+
+    def select_all(self) -> None:
+        self.set_selection({cid: range(len(self.doc.channels[cid].keys)) for cid in self.visible})
+
+    # ------------------------------------------------------------- editing
+    def push(self, command: Command) -> None:
+        self.ctx.push(command)
+
+    def delete_selected(self) -> None:
+        sel = self.selected_keys()
+        if not sel:
+            return
+        self.selection.clear()
+        self.active = None
+        self.push(DeleteKeys(self.doc, sel))
+        self.keySelectionChanged.emit()
+
+    def insert_key_at(self, scene: QPointF) -> tuple[str, int] | None:
+        """Ctrl+click: a key on the curve under the cursor (or the one highlighted channel)."""
+        view = self.vb.mapSceneToView(scene)
+        frame = round(view.x()) if self.snap else view.x()
+        t = frame / self.fps
+        cid = self.curve_at(scene)
+        if cid is not None:
+            value = float(self.doc.channels[cid].evaluate(t))
+        else:
+            candidates = [c for c in self.visible if c in self.highlighted]
+            if len(candidates) != 1:
+                return None
+            cid = candidates[0]
+            off, scale = self.display_transform(cid)
+            value = view.y() / scale + off
+        self.push(InsertKey(self.doc, cid, Key(t, value), text="Insert Key"))
+        index = self.doc.channels[cid].key_index(t)
+        if index is None:
+            return None
+        self.set_selection({cid: [index]}, (cid, index))
+        return cid, index
+
+    def frame_all(self) -> None:
+        self._frame_bounds(self._bounds({cid: None for cid in self.visible}))
+
+    def frame_selected(self) -> None:
+        sel = self.selected_keys()
+        if sel:
+            self._frame_bounds(self._bounds(sel))
+        elif self.highlighted & set(self.visible):
+            self._frame_bounds(self._bounds({c: None for c in self.visible if c in self.highlighted}))
+        else:
+            self.frame_all()
+
+    def _bounds(self, which: dict[str, list[int] | None]) -> tuple[float, float, float, float] | None:
+        xs: list[float] = []
+        ys: list[float] = []
+        fps = self.fps
+        for cid, idx in which.items():
+            ch = self.doc.channels.get(cid)
+            if ch is None or not ch.keys:
+                continue
+            off, scale = self.display_transform(cid)
+            times, values = ch.times, ch.values
+            if idx is None:
+                xs += [float(times[0] * fps), float(times[-1] * fps)]
+                noff, nscale = self.cache.normalisation(cid, ch)
+                lo, hi = noff - 1.0 / nscale, noff + 1.0 / nscale
+                ys += [(lo - off) * scale, (hi - off) * scale]
+            else:
+                xs += [float(times[i] * fps) for i in idx]
+                ys += [float((values[i] - off) * scale) for i in idx]
+        if not xs:
+            return None
+        return min(xs), max(xs), min(ys), max(ys)
+
+    def _frame_bounds(self, b: tuple[float, float, float, float] | None) -> None:
+        if b is None:
+            start, end = self.doc.frame_range
+            b = (float(start), float(end), -1.0, 1.0)
+        x0, x1, y0, y1 = b
+        if x1 - x0 < 1e-9:
+            x0, x1 = x0 - 10.0, x1 + 10.0
+        if y1 - y0 < 1e-9:
+            pad = max(0.5, abs(y0) * 0.1)
+            y0, y1 = y0 - pad, y1 + pad
+        self.vb.setRange(xRange=(x0, x1), yRange=(y0, y1), padding=0.08)
+
+    # ---------------------------------------------------------- frame line
+    def _frame_changed(self, frame: float) -> None:
+        self._syncing_frame = True
+        try:
+            self.frame_line.setValue(frame)
+        finally:
+            self._syncing_frame = False
+
+    def _frame_line_moved(self) -> None:
+        if self._syncing_frame:
+            return
+        frame = float(round(self.frame_line.value()))
+        if frame != self.frame_line.value():
+            self.frame_line.setValue(frame)
+            return
+        self.ctx.set_frame(frame)
+
+    # ------------------------------------------------------------- gestures
+    def click(self, scene: QPointF, mods: Qt.KeyboardModifier) -> None:
+        self.widget.setFocus()
+        shift = bool(mods & Qt.KeyboardModifier.ShiftModifier)
+        if mods & Qt.KeyboardModifier.ControlModifier:
+            self.insert_key_at(scene)
+            return
+        if self.handle_at(scene) is not None:
+            return
+        hit = self.key_at(scene)
+        if hit is not None:
+            cid, i = hit
+            sel = {c: set(s) for c, s in self.selection.items()}
+            if shift:
+                s = sel.setdefault(cid, set())
+                s.symmetric_difference_update({i})
+            else:
+                sel = {cid: {i}}
+            self.set_selection(sel, hit)
+            return
+        cid = self.curve_at(scene)
+        if cid is not None and not shift:
+            asset, joint, _dof = split_channel_id(cid)
+            self.ctx.select(asset, joint)
+            self.ctx.select_channels([cid])
+        if not shift:
+            self.clear_selection()
+
+    def drag_event(self, ev: Any) -> bool:
+        """Handle a pyqtgraph drag event; False lets the ViewBox pan or zoom."""
+        button = ev.button()
+        mods = ev.modifiers()
+        if ev.isStart():
+            self._drag = None
+            if button != Qt.MouseButton.LeftButton or mods & Qt.KeyboardModifier.AltModifier:
+                return False
+            self.widget.setFocus()
+            self._drag = self._begin_drag(ev.buttonDownScenePos(), mods | self.press_modifiers)
+            self._update_live()
+        drag = self._drag
+        if drag is None:
+            return False
+        ev.accept()
+        if drag.kind == "aborted":
+            if ev.isFinish():
+                self._drag = None
+            return True
+        if drag.kind == "keys":
+            self._drag_keys(drag, ev.scenePos(), mods)
+        elif drag.kind == "scale":
+            self._drag_scale(drag, ev.scenePos())
+        elif drag.kind == "handle":
+            self._drag_handle(drag, ev.scenePos())
+        elif drag.kind == "box":
+            self._drag_box(drag, ev.scenePos(), finish=ev.isFinish())
+        if ev.isFinish():
+            self._finish_drag(drag)
+        return True
+
+    def _begin_drag(self, scene: QPointF, mods: Qt.KeyboardModifier) -> _Drag:
+        shift = bool(mods & Qt.KeyboardModifier.ShiftModifier)
+        gesture = ("curve-editor", next(_gesture_ids))
+        handle = self.handle_at(scene)
+        if handle is not None:
+            cid, i, side = handle
+            self._frozen_norm = {cid: self.display_transform(cid)}
+            return _Drag("handle", gesture, anchor=(cid, i), side=side, start_scene=scene,
+                         base={cid: self.doc.channels[cid]})
+        hit = self.key_at(scene)
+        if hit is not None:
+            cid, i = hit
+            if i not in self.selection.get(cid, set()):
+                sel = {c: set(s) for c, s in self.selection.items()} if shift else {}
+                sel.setdefault(cid, set()).add(i)
+                self.set_selection(sel, hit)
+            selection = self.selected_keys()
+            base = {c: self.doc.channels[c] for c in selection}
+            self._frozen_norm = {c: self.display_transform(c) for c in selection}
+            kind = "scale" if mods & Qt.KeyboardModifier.ControlModifier else "keys"
+            return _Drag(kind, gesture, base=base, selection=selection, anchor=hit, start_scene=scene)
+        return _Drag("box", start_scene=scene, additive=shift)
+
+    def _drag_keys(self, drag: _Drag, scene: QPointF, mods: Qt.KeyboardModifier) -> None:
+        start = self.vb.mapSceneToView(drag.start_scene)
+        cur = self.vb.mapSceneToView(scene)
+        dx = cur.x() - start.x()
+        dy = cur.y() - start.y()
+        lock = self.axis_lock
+        if mods & Qt.KeyboardModifier.ShiftModifier:
+            # Shift held while dragging: constrain to the axis the mouse moved most along.
+            lock = "time" if abs(scene.x() - drag.start_scene.x()) >= abs(scene.y() - drag.start_scene.y()) \
+                else "value"
+        if lock == "time":
+            dy = 0.0
+        elif lock == "value":
+            dx = 0.0
+        assert drag.anchor is not None
+        anchor_frame = drag.base[drag.anchor[0]].keys[drag.anchor[1]].time * self.fps
+        if self.snap:
+            dx = round(anchor_frame + dx) - anchor_frame
+        dt = dx / self.fps
+        dv = {cid: dy / self.display_transform(cid)[1] for cid in drag.selection}
+        if not drag.pushed and dt == 0.0 and dy == 0.0:
+            return
+        try:
+            cmd = MoveCurveKeys(drag.base, drag.selection, dt, dv, gesture=drag.gesture)
+        except ValueError:
+            return  # a key would land on another key's time: keep the last valid position
+        self.push(cmd)
+        drag.pushed = True
+        self._remap_selection(drag, lambda t: t + dt)
+
+    def _drag_scale(self, drag: _Drag, scene: QPointF) -> None:
+        """Ctrl+drag on a key: scale the selected keys' times about the current frame."""
+        assert drag.anchor is not None
+        pivot = self.ctx.frame
+        anchor_frame = drag.base[drag.anchor[0]].keys[drag.anchor[1]].time * self.fps
+        start = self.vb.mapSceneToView(drag.start_scene).x()
+        target = anchor_frame + self.vb.mapSceneToView(scene).x() - start
+        if self.snap:
+            target = round(target)
+        if abs(anchor_frame - pivot) < 1e-9:
+            return
+        factor = (target - pivot) / (anchor_frame - pivot)
+        if factor <= 0.0 or (factor == 1.0 and not drag.pushed):
+            return
+        p = pivot / self.fps
+        try:
+            cmd = MoveCurveKeys(drag.base, drag.selection, 0.0, 0.0, gesture=drag.gesture,
+                                text="Scale Keys", time_scale=(p, factor))
+        except ValueError:
+            return
+        self.push(cmd)
+        drag.pushed = True
+        self._remap_selection(drag, lambda t: p + (t - p) * factor)
+
+    def _remap_selection(self, drag: _Drag, new_time: Callable[[float], float]) -> None:
+        """Keys may pass others while moving: find the moved keys' new indices."""
+        new_sel: dict[str, set[int]] = {}
+        active = None
+        for cid, idx in drag.selection.items():
+            ch = self.doc.channels[cid]
+            times = ch.times
+            found = set()
+            for i in idx:
+                t = new_time(drag.base[cid].keys[i].time)
+                j = int(np.argmin(np.abs(times - t)))
+                found.add(j)
+                if drag.anchor == (cid, i):
+                    active = (cid, j)
+            new_sel[cid] = found
+        self.selection = new_sel
+        self.active = active or self._first_selected()
+        self._update_live()
+        self.keySelectionChanged.emit()
+
+    def _drag_handle(self, drag: _Drag, scene: QPointF) -> None:
+        assert drag.anchor is not None
+        cid, i = drag.anchor
+        ch = self.doc.channels[cid]
+        key = ch.keys[i]
+        off, scale = self.display_transform(cid)
+        kview = QPointF(key.time * self.fps, (key.value - off) * scale)
+        cur = self.vb.mapSceneToView(scene)
+        dx = cur.x() - kview.x()
+        dy = cur.y() - kview.y()
+        # An out handle stays right of its key and an in handle left of it.
+        min_dx = 1e-6 * max(1.0, abs(self.vb.viewRange()[0][1] - self.vb.viewRange()[0][0]))
+        if drag.side == "out":
+            dx = max(dx, min_dx)
+        else:
+            dx = min(dx, -min_dx)
+        slope = (dy / dx) * self.fps / scale
+        if key.broken:
+            ins, outs = (slope, None) if drag.side == "in" else (None, slope)
+        else:
+            ins, outs = slope, slope
+        self.push(SetKeySlopes(self.doc, cid, i, ins, outs, gesture=drag.gesture))
+        drag.pushed = True
+        self._update_live()
+        self.keySelectionChanged.emit()
+
+    def _drag_box(self, drag: _Drag, scene: QPointF, finish: bool) -> None:
+        a = self.vb.mapSceneToView(drag.start_scene)
+        b = self.vb.mapSceneToView(scene)
+        rect = QRectF(a, b).normalized()
+        if not finish:
+            self.box.setRect(rect)
+            self.box.show()
+            return
+        self.box.hide()
+        sel = {c: set(s) for c, s in self.selection.items()} if drag.additive else {}
+        fps = self.fps
+        for cid in self.visible:
+            ch = self.doc.channels.get(cid)
+            if ch is None or not ch.keys:
+                continue
+            off, scale = self.display_transform(cid)
+            x = ch.times * fps
+            y = (ch.values - off) * scale
+            inside = (x >= rect.left()) & (x <= rect.right()) & (y >= rect.top()) & (y <= rect.bottom())
+            hits = set(np.nonzero(inside)[0].tolist())
+            if hits:
+                sel.setdefault(cid, set()).update(hits)
+        self.set_selection(sel)
+
+    def _finish_drag(self, drag: _Drag) -> None:
+        self._drag = None
+        if drag.kind in ("keys", "scale"):
+            self._frozen_norm.clear()
+            if drag.pushed and all(self.doc.channels.get(c) == ch for c, ch in drag.base.items()):
+                self._drop_gesture(drag)  # back where it started: no undo step
+            self.refresh_all()
+        elif drag.kind == "handle":
+            self._frozen_norm.clear()
+            self.refresh_all()
+
+    @property
+    def dragging(self) -> bool:
+        return self._drag is not None and self._drag.kind != "aborted"
+
+    def abort_drag(self) -> bool:
+        """Escape: put everything back as it was before the drag and forget the gesture."""
+        drag = self._drag
+        if drag is None or drag.kind == "aborted":
+            return False
+        if drag.kind in ("keys", "scale", "handle") and drag.pushed:
+            self._drop_gesture(drag)
+            if drag.kind != "handle":
+                self.set_selection(drag.selection, drag.anchor)
+        self.box.hide()
+        self._frozen_norm.clear()
+        self._drag = _Drag("aborted")
+        self.refresh_all()
+        return True
+
+    def _drop_gesture(self, drag: _Drag) -> None:
+        """Undo the merged command of ``drag`` and remove it from the undo stack."""
+        stack = self.ctx.undo_stack
+        top = stack.command(stack.index() - 1) if stack.index() > 0 else None
+        command = getattr(top, "command", None)
+        if top is None or command is None or command.gesture != drag.gesture:
+            return
+        command.undo(self.doc)
+        top.setObsolete(True)
+        stack.undo()  # an obsolete command is removed without being undone again
+
+    # ------------------------------------------------------------------ keys
+    _KEYS = {Qt.Key.Key_A, Qt.Key.Key_F, Qt.Key.Key_Home, Qt.Key.Key_Delete, Qt.Key.Key_Backspace,
+             Qt.Key.Key_N, Qt.Key.Key_Escape}
+
+    def handles_key(self, ev: QKeyEvent) -> bool:
+        mods = ev.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+        if ev.key() == Qt.Key.Key_A and mods == Qt.KeyboardModifier.ControlModifier:
+            return True
+        if ev.key() == Qt.Key.Key_Escape:
+            return self.dragging
+        return mods == Qt.KeyboardModifier.NoModifier and ev.key() in self._KEYS
+
+    def key_press(self, ev: QKeyEvent) -> bool:
+        key = ev.key()
+        mods = ev.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+        if key == Qt.Key.Key_Escape:
+            return self.abort_drag()
+        if mods not in (Qt.KeyboardModifier.NoModifier,):
+            if key == Qt.Key.Key_A and mods == Qt.KeyboardModifier.ControlModifier:
+                self.select_all()
+                return True
+            return False
+        actions: dict[int, Callable[[], None]] = {
+            Qt.Key.Key_A: self.frame_all,
+            Qt.Key.Key_F: self.frame_selected,
+            Qt.Key.Key_Home: self.frame_all,
+            Qt.Key.Key_Delete: self.delete_selected,
+            Qt.Key.Key_Backspace: self.delete_selected,
+            Qt.Key.Key_N: lambda: self.set_normalised(not self.normalised),
+        }
+        fn = actions.get(key)
+        if fn is None:
+            return False
+        fn()
+        return True

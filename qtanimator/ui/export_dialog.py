@@ -1,0 +1,267 @@
+"""File > Export Animation…: a PNG sequence, a GIF or an MP4 of the 2D scene.
+
+The dialog picks the format, the output, the image size, the frame rate and the frame
+range; the frames are rendered with the shared 2D renderer and written by
+``qtanimator.render.export.write_frames`` while a QProgressDialog shows progress and
+offers Cancel.
+"""
+
+from __future__ import annotations
+
+import inspect
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from PySide6.QtCore import Qt
+from PySide6.QtGui import QAction, QColor, QKeySequence
+from PySide6.QtWidgets import (
+    QApplication,
+    QComboBox,
+    QDialog,
+    QDialogButtonBox,
+    QDoubleSpinBox,
+    QFileDialog,
+    QFormLayout,
+    QHBoxLayout,
+    QLineEdit,
+    QProgressDialog,
+    QPushButton,
+    QSpinBox,
+    QWidget,
+)
+
+from qtanimator.document.document import Document
+
+if TYPE_CHECKING:
+    from qtanimator.ui.main_window import MainWindow
+
+FORMATS = {
+    "png": ("PNG sequence", ""),
+    "gif": ("Animated GIF", ".gif"),
+    "mp4": ("MP4 video (H.264)", ".mp4"),
+}
+
+#: The reference program's export background (0.6, 0.6, 0.95).
+DEFAULT_BACKGROUND = QColor(153, 153, 242)
+
+
+@dataclass
+class ExportSettings:
+    """What to export: ``out`` is a folder or ``…%04d.png`` pattern for PNG, else a file."""
+
+    out: str
+    fmt: str = "png"
+    width: int = 960
+    height: int = 640
+    fps: float = 60.0
+    first: int = 0
+    last: int = 240
+    background: QColor | None = None
+
+
+def default_settings(doc: Document) -> ExportSettings:
+    first, last = doc.frame_range
+    base = Path(doc.path).with_suffix("") if doc.path else Path.cwd() / "animation"
+    return ExportSettings(out=str(base.parent / f"{base.name}_frames"), fmt="png", fps=doc.fps,
+                          first=first, last=last)
+
+
+def output_target(settings: ExportSettings) -> str:
+    """The path ``write_frames`` receives: the extension decides the format."""
+    out = settings.out
+    if settings.fmt == "png":
+        return out
+    suffix = FORMATS[settings.fmt][1]
+    return out if out.lower().endswith(suffix) else out + suffix
+
+
+def render_frames(doc: Document, settings: ExportSettings) -> Iterator[Any]:
+    """RGBA arrays of the range, rendered in order (so pendulums simulate forward), with
+    one camera for the whole range (the union of the characters' bounds)."""
+    from qtanimator.render.painter2d import animation_bounds, image_to_array, render_frame
+
+    background = settings.background or DEFAULT_BACKGROUND
+    frames = list(range(settings.first, settings.last + 1))
+    sample = frames[::max(len(frames) // 24, 1)] + frames[-1:]
+    view = animation_bounds(doc, [doc.frame_to_time(f) for f in sample])
+    size = (settings.width, settings.height)
+    for frame in frames:
+        image = render_frame(doc, doc.frame_to_time(frame), size, background,
+                             view=view if not view.isEmpty() else None)
+        yield image_to_array(image)
+
+
+def _call_progress(progress: Callable[[int, int], bool] | None, done: int, total: int) -> bool:
+    return True if progress is None else bool(progress(done, total))
+
+
+def export_animation(doc: Document, settings: ExportSettings,
+                     progress: Callable[[int, int], bool] | None = None) -> int:
+    """Render and write the frames; ``progress(done, total)`` returning False cancels.
+
+    Returns the number of frames written.
+    """
+    from qtanimator.render.export import write_frames
+
+    total = max(settings.last - settings.first + 1, 0)
+    cancelled = False
+
+    def on_progress(*args: Any) -> None:
+        nonlocal cancelled
+        done = int(args[0]) if args else 0
+        if not _call_progress(progress, done, total):
+            cancelled = True
+
+    def cancel() -> bool:
+        return cancelled
+
+    frames = render_frames(doc, settings)
+    params = inspect.signature(write_frames).parameters
+    kwargs: dict[str, Any] = {}
+    if "progress" in params:
+        kwargs["progress"] = on_progress
+    if "cancel" in params:
+        kwargs["cancel"] = cancel
+    target = output_target(settings)
+    if settings.fmt == "png":
+        Path(target if "%" not in target else Path(target).parent).mkdir(parents=True, exist_ok=True)
+    return int(write_frames(frames, target, settings.fps, **kwargs))
+
+
+class ExportDialog(QDialog):
+    """The settings form; ``settings()`` reads it back."""
+
+    def __init__(self, doc: Document, parent: QWidget | None = None,
+                 initial: ExportSettings | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("exportDialog")
+        self.setWindowTitle("Export Animation")
+        s = initial or default_settings(doc)
+        form = QFormLayout(self)
+        self.format_box = QComboBox(self)
+        self.format_box.setObjectName("exportFormat")
+        for key, (label, _suffix) in FORMATS.items():
+            self.format_box.addItem(label, key)
+        self.format_box.setCurrentIndex(list(FORMATS).index(s.fmt))
+        form.addRow("Format", self.format_box)
+        row = QHBoxLayout()
+        self.path_edit = QLineEdit(s.out, self)
+        self.path_edit.setObjectName("exportPath")
+        browse = QPushButton("Browse…", self)
+        browse.clicked.connect(self._browse)
+        row.addWidget(self.path_edit, 1)
+        row.addWidget(browse)
+        form.addRow("Output", row)
+        self.width_box = _spin(self, "exportWidth", 16, 8192, s.width)
+        self.height_box = _spin(self, "exportHeight", 16, 8192, s.height)
+        size_row = QHBoxLayout()
+        size_row.addWidget(self.width_box)
+        size_row.addWidget(self.height_box)
+        form.addRow("Size", size_row)
+        self.fps_box = QDoubleSpinBox(self)
+        self.fps_box.setObjectName("exportFps")
+        self.fps_box.setRange(1.0, 240.0)
+        self.fps_box.setValue(s.fps)
+        form.addRow("Frame rate", self.fps_box)
+        self.first_box = _spin(self, "exportFirst", -100000, 100000, s.first)
+        self.last_box = _spin(self, "exportLast", -100000, 100000, s.last)
+        range_row = QHBoxLayout()
+        range_row.addWidget(self.first_box)
+        range_row.addWidget(self.last_box)
+        form.addRow("Frames", range_row)
+        buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel,
+                                   self)
+        buttons.button(QDialogButtonBox.StandardButton.Ok).setText("Export")
+        buttons.accepted.connect(self.accept)
+        buttons.rejected.connect(self.reject)
+        form.addRow(buttons)
+        self.format_box.currentIndexChanged.connect(self._format_changed)
+
+    def _format_changed(self) -> None:
+        fmt = self.format_box.currentData()
+        out = self.path_edit.text()
+        stem = out
+        for _label, suffix in FORMATS.values():
+            if suffix and stem.lower().endswith(suffix):
+                stem = stem[: -len(suffix)]
+        self.path_edit.setText(stem + FORMATS[fmt][1])
+
+    def _browse(self) -> None:
+        fmt = self.format_box.currentData()
+        if fmt == "png":
+            path = QFileDialog.getExistingDirectory(self, "Folder for the frames", self.path_edit.text())
+        else:
+            suffix = FORMATS[fmt][1]
+            path, _ = QFileDialog.getSaveFileName(self, "Export to", self.path_edit.text(),
+                                                  f"{FORMATS[fmt][0]} (*{suffix})")
+        if path:
+            self.path_edit.setText(path)
+
+    def settings(self) -> ExportSettings:
+        return ExportSettings(out=self.path_edit.text(), fmt=str(self.format_box.currentData()),
+                              width=self.width_box.value(), height=self.height_box.value(),
+                              fps=self.fps_box.value(), first=self.first_box.value(),
+                              last=max(self.last_box.value(), self.first_box.value()))
+
+
+def _spin(parent: QWidget, name: str, lo: int, hi: int, value: int) -> QSpinBox:
+    box = QSpinBox(parent)
+    box.setObjectName(name)
+    box.setRange(lo, hi)
+    box.setValue(value)
+    return box
+
+
+def run_export(window: MainWindow, settings: ExportSettings) -> int:
+    """Export with a progress dialog (Cancel stops after the current frame)."""
+    total = max(settings.last - settings.first + 1, 1)
+    dialog = QProgressDialog("Exporting animation…", "Cancel", 0, total, window)
+    dialog.setObjectName("exportProgress")
+    dialog.setWindowTitle("Export Animation")
+    dialog.setWindowModality(Qt.WindowModality.WindowModal)
+    dialog.setMinimumDuration(0)
+    dialog.setValue(0)
+    window.export_progress = dialog  # type: ignore[attr-defined]
+
+    def progress(done: int, n: int) -> bool:
+        dialog.setValue(min(done, total))
+        QApplication.processEvents()
+        return not dialog.wasCanceled()
+
+    try:
+        written = export_animation(window.doc, settings, progress)
+    except (OSError, ValueError, RuntimeError) as exc:
+        dialog.close()
+        window.show_error("Cannot export", str(exc))
+        return 0
+    finally:
+        cancelled = dialog.wasCanceled()
+        dialog.reset()
+        dialog.deleteLater()
+        window.export_progress = None  # type: ignore[attr-defined]
+    if cancelled:
+        window.statusBar().showMessage(f"Export cancelled after {written} frames.", 5000)
+    else:
+        window.statusBar().showMessage(f"Exported {written} frames to {output_target(settings)}.", 5000)
+    return written
+
+
+def open_export_dialog(window: MainWindow) -> int:
+    previous = getattr(window, "export_settings", None)
+    dialog = ExportDialog(window.doc, window, previous)
+    if dialog.exec() != QDialog.DialogCode.Accepted:
+        return 0
+    settings = dialog.settings()
+    window.export_settings = settings  # type: ignore[attr-defined]
+    return run_export(window, settings)
+
+
+def install(window: MainWindow) -> None:
+    action = QAction("&Export Animation…", window)
+    action.setObjectName("actionExport")
+    action.setShortcut(QKeySequence("Ctrl+E"))
+    action.triggered.connect(lambda _checked=False: open_export_dialog(window))
+    window.file_menu.insertAction(window.export_separator, action)
+    window.action_export = action  # type: ignore[attr-defined]

@@ -1,0 +1,484 @@
+"""The joint tree dock: every 2D character and 3D skeleton with its joints, and the DOF panel.
+
+The tree follows ``ctx.selection`` and sets it; keyframed joints carry a key icon (filled
+once the joint has keys), dynamic (pendulum) joints a white bob. Below the tree, the DOF
+panel shows one slider and spin box per degree of freedom of the selected joint within
+its limits; an edit keys the DOF at the current frame, and one slider drag is one undo
+step (every command of the drag shares a gesture token).
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from types import ModuleType
+from typing import TYPE_CHECKING
+
+import numpy as np
+from PySide6.QtCore import QPointF, Qt
+from PySide6.QtGui import QAction, QBrush, QColor, QIcon, QKeySequence, QPainter, QPen, QPixmap, QPolygonF
+from PySide6.QtWidgets import (
+    QDoubleSpinBox,
+    QGridLayout,
+    QHBoxLayout,
+    QLabel,
+    QPushButton,
+    QSlider,
+    QTreeWidget,
+    QTreeWidgetItem,
+    QVBoxLayout,
+    QWidget,
+)
+
+from qtanimator.document.commands import Command, Macro
+from qtanimator.document.document import ChangeEvent, Document, split_channel_id
+from qtanimator.ui.context import EditorContext
+
+if TYPE_CHECKING:
+    from qtanimator.ui.main_window import MainWindow
+
+ROLE = Qt.ItemDataRole.UserRole
+SLIDER_STEPS_PER_UNIT = 10  # 0.1° (or 0.1 unit) per slider step
+TRANSLATION_LIMIT = 5000.0
+
+
+def optional_module(name: str) -> ModuleType | None:
+    """An engine module, or None while it does not exist yet."""
+    try:
+        return importlib.import_module(name)
+    except ModuleNotFoundError as exc:
+        if exc.name is not None and name.startswith(exc.name):
+            return None
+        raise
+
+
+def c2d() -> ModuleType | None:
+    return optional_module("qtanimator.document.character2d")
+
+
+def c3d() -> ModuleType | None:
+    return optional_module("qtanimator.document.character3d")
+
+
+# ------------------------------------------------------------------------ DOFs
+@dataclass
+class DofSpec:
+    """One editable degree of freedom of the selected joint.
+
+    ``value`` and the limits are in display units (degrees for angles); ``make`` builds
+    the keying command from a display value, the current time and a gesture token.
+    """
+
+    label: str
+    value: float
+    minimum: float
+    maximum: float
+    make: Callable[[float, float, object], Command]
+    suffix: str = "°"
+
+
+def _asset_kind(doc: Document, asset: str) -> str:
+    a = doc.assets.get(asset)
+    return a.kind if a is not None else ""
+
+
+def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpec]:
+    """The DOFs of ``(asset, joint)`` at ``time``; a character's own row (joint "") has
+    its position."""
+    kind = _asset_kind(doc, asset)
+    runtime = doc.runtime.get(asset)
+    m2, m3 = c2d(), c3d()
+    if m2 is not None and kind == m2.ASSET_KIND and runtime is not None:
+        pose = m2.evaluate_pose(doc, asset, time)
+        if joint == "":
+            tx, ty = (float(v) for v in pose.translation)
+
+            def move(axis: int) -> Callable[[float, float, object], Command]:
+                def make(value: float, t: float, gesture: object) -> Command:
+                    cur = m2.evaluate_pose(doc, asset, t).translation
+                    xy = (value, float(cur[1])) if axis == 0 else (float(cur[0]), value)
+                    return m2.move_character(doc, asset, xy, t, gesture=gesture)
+                return make
+
+            return [DofSpec("x", tx, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(0), ""),
+                    DofSpec("y", ty, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(1), "")]
+        index = runtime.joint_index(joint)
+        angle = float(np.asarray(m2.joint_angles(doc, asset, time))[index])
+
+        def key(value: float, t: float, gesture: object) -> Command:
+            return m2.key_joint(doc, asset, index, math.radians(value), t, gesture=gesture)
+
+        return [DofSpec("angle", math.degrees(angle), -360.0, 360.0, key)]
+    if m3 is not None and kind == m3.ASSET_KIND and runtime is not None and joint:
+        skeleton = m3.pose_skeleton(doc, asset, time) if hasattr(m3, "pose_skeleton") else runtime
+        skel_joints = list(skeleton.joints)
+        names = [j.name for j in skel_joints]
+        if joint not in names:
+            return []
+        index = names.index(joint)
+        specs = []
+        for axis_i, axis in enumerate("xyz"):
+            dof = skel_joints[index].dofs[axis_i]
+            lo, hi = float(dof.min), float(dof.max)
+            if lo >= hi:
+                continue  # a locked DOF
+            lo, hi = max(lo, -math.pi), min(hi, math.pi) if math.isfinite(hi) else math.pi
+
+            def set_dof(value: float, t: float, gesture: object, a: str = axis) -> Command:
+                return m3.set_dof_command(doc, asset, index, a, math.radians(value), t, gesture=gesture)
+
+            specs.append(DofSpec(f"rotate {axis}", math.degrees(float(dof.value)), math.degrees(lo),
+                                 math.degrees(hi), set_dof))
+        return specs
+    return []
+
+
+def joint_names(doc: Document, asset: str) -> list[tuple[str, int | None, bool]]:
+    """``(name, parent index, is_dynamic)`` for the joints of a 2D or 3D asset."""
+    runtime = doc.runtime.get(asset)
+    if runtime is None:
+        return []
+    joints = getattr(runtime, "joints", None)
+    if joints is None and hasattr(runtime, "skeleton"):
+        joints = runtime.skeleton.joints
+    if joints is None:
+        return []
+    out = []
+    for j in joints:
+        parent = j.parent if j.parent is None or j.parent >= 0 else None
+        out.append((str(j.name), parent, bool(getattr(j, "is_dynamic", False))))
+    return out
+
+
+def reset_pose_command(doc: Document, asset: str, time: float, gesture: object = None) -> Command | None:
+    """Every joint of ``asset`` back to its rest angle, keyed at ``time`` (one step)."""
+    kind = _asset_kind(doc, asset)
+    m2, m3 = c2d(), c3d()
+    commands: list[Command] = []
+    if m2 is not None and kind == m2.ASSET_KIND:
+        n = len(doc.runtime[asset].joints)
+        for j in range(n):
+            cmd = m2.key_joint(doc, asset, j, 0.0, time, gesture=gesture)
+            cmd.do(doc)  # later keys build on this one; undone below
+            commands.append(cmd)
+    elif m3 is not None and kind == m3.ASSET_KIND:
+        for j, _name in enumerate(joint_names(doc, asset)):
+            for axis in "xyz":
+                cmd = m3.set_dof_command(doc, asset, j, axis, 0.0, time, gesture=gesture)
+                cmd.do(doc)
+                commands.append(cmd)
+    for cmd in reversed(commands):
+        cmd.undo(doc)
+    return Macro("Reset Pose", commands) if commands else None
+
+
+# ------------------------------------------------------------------------ icons
+def _icon(kind: str) -> QIcon:
+    pix = QPixmap(16, 16)
+    pix.fill(Qt.GlobalColor.transparent)
+    p = QPainter(pix)
+    p.setRenderHint(QPainter.RenderHint.Antialiasing)
+    if kind == "dynamic":
+        p.setPen(QPen(QColor(40, 40, 40), 1.2))
+        p.drawLine(QPointF(8, 1), QPointF(8, 8))
+        p.setBrush(QBrush(QColor(255, 255, 255)))
+        p.drawEllipse(QPointF(8, 11), 4, 4)
+    elif kind in ("keyed", "key"):
+        diamond = QPolygonF([QPointF(8, 2), QPointF(14, 8), QPointF(8, 14), QPointF(2, 8)])
+        p.setPen(QPen(QColor(150, 80, 0), 1.2))
+        p.setBrush(QBrush(QColor(255, 160, 0)) if kind == "keyed" else Qt.BrushStyle.NoBrush)
+        p.drawPolygon(diamond)
+    elif kind == "character":
+        p.setPen(QPen(QColor(30, 30, 30), 1.2))
+        p.setBrush(QBrush(QColor(120, 170, 255)))
+        p.drawEllipse(QPointF(8, 5), 3, 3)
+        p.drawRoundedRect(4, 9, 8, 6, 2, 2)
+    else:
+        p.setPen(QPen(QColor(30, 30, 30), 1.2))
+        p.setBrush(QBrush(QColor(180, 220, 140)))
+        p.drawRect(3, 3, 10, 10)
+    p.end()
+    return QIcon(pix)
+
+
+# ----------------------------------------------------------------------- widgets
+class DofRow:
+    """Slider and spin box for one DOF; edits key through ``panel``."""
+
+    def __init__(self, panel: DofPanel, grid: QGridLayout, row: int, spec: DofSpec) -> None:
+        self.panel = panel
+        self.spec = spec
+        self.label = QLabel(spec.label, panel)
+        self.slider = QSlider(Qt.Orientation.Horizontal, panel)
+        self.slider.setObjectName(f"dofSlider_{spec.label.replace(' ', '_')}")
+        self.slider.setRange(int(math.floor(spec.minimum * SLIDER_STEPS_PER_UNIT)),
+                             int(math.ceil(spec.maximum * SLIDER_STEPS_PER_UNIT)))
+        self.slider.setPageStep(10 * SLIDER_STEPS_PER_UNIT)
+        self.spin = QDoubleSpinBox(panel)
+        self.spin.setObjectName(f"dofSpin_{spec.label.replace(' ', '_')}")
+        self.spin.setDecimals(2)
+        self.spin.setRange(spec.minimum, spec.maximum)
+        self.spin.setSuffix(spec.suffix)
+        self.spin.setKeyboardTracking(False)
+        self.spin.setSingleStep(1.0)
+        grid.addWidget(self.label, row, 0)
+        grid.addWidget(self.slider, row, 1)
+        grid.addWidget(self.spin, row, 2)
+        self._gesture: object | None = None
+        self.set_value(spec.value)
+        self.slider.sliderPressed.connect(self._begin)
+        self.slider.sliderReleased.connect(self._end)
+        self.slider.valueChanged.connect(self._slider_changed)
+        self.spin.valueChanged.connect(self._spin_changed)
+
+    def widgets(self) -> list[QWidget]:
+        return [self.label, self.slider, self.spin]
+
+    def set_value(self, value: float) -> None:
+        self.spec.value = value
+        for w in (self.slider, self.spin):
+            w.blockSignals(True)
+        self.slider.setValue(int(round(value * SLIDER_STEPS_PER_UNIT)))
+        self.spin.setValue(value)
+        for w in (self.slider, self.spin):
+            w.blockSignals(False)
+
+    def _begin(self) -> None:
+        self._gesture = ("dof-slider", object())
+
+    def _end(self) -> None:
+        self._gesture = None
+
+    def _slider_changed(self, v: int) -> None:
+        value = v / SLIDER_STEPS_PER_UNIT
+        gesture = self._gesture if self._gesture is not None else ("dof-step", object())
+        self.spin.blockSignals(True)
+        self.spin.setValue(value)
+        self.spin.blockSignals(False)
+        self.panel.key(self.spec, value, gesture)
+
+    def _spin_changed(self, value: float) -> None:
+        self.slider.blockSignals(True)
+        self.slider.setValue(int(round(value * SLIDER_STEPS_PER_UNIT)))
+        self.slider.blockSignals(False)
+        self.panel.key(self.spec, value, ("dof-spin", object()))
+
+
+class DofPanel(QWidget):
+    """The sliders of the selected joint, plus previous / next joint and reset pose."""
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("dofPanel")
+        self.ctx = ctx
+        self.rows: list[DofRow] = []
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(2, 2, 2, 2)
+        self.title = QLabel("No joint selected", self)
+        self.title.setObjectName("dofTitle")
+        layout.addWidget(self.title)
+        self.grid_host = QWidget(self)
+        self.grid = QGridLayout(self.grid_host)
+        self.grid.setContentsMargins(0, 0, 0, 0)
+        layout.addWidget(self.grid_host)
+        buttons = QHBoxLayout()
+        self.prev_button = QPushButton("◀ Previous", self)
+        self.prev_button.setObjectName("previousJointButton")
+        self.next_button = QPushButton("Next ▶", self)
+        self.next_button.setObjectName("nextJointButton")
+        self.reset_button = QPushButton("Reset Pose (R)", self)
+        self.reset_button.setObjectName("resetPoseButton")
+        for b in (self.prev_button, self.next_button, self.reset_button):
+            buttons.addWidget(b)
+        layout.addLayout(buttons)
+        layout.addStretch(1)
+        self._editing = False
+        self._shown: tuple[str, str, tuple[str, ...]] | None = None
+
+    def rebuild(self) -> None:
+        asset, joint = self.ctx.selection
+        specs = dof_specs(self.ctx.doc, asset, joint, self.ctx.time) if asset else []
+        key = (asset, joint, tuple(s.label for s in specs))
+        if key == self._shown and len(self.rows) == len(specs):
+            for row, spec in zip(self.rows, specs):
+                row.spec = spec
+                row.set_value(spec.value)
+            return
+        for row in self.rows:
+            for w in row.widgets():
+                self.grid.removeWidget(w)
+                w.deleteLater()
+        self.rows = [DofRow(self, self.grid, i, s) for i, s in enumerate(specs)]
+        self._shown = key
+        if not asset:
+            self.title.setText("No joint selected")
+        else:
+            self.title.setText(f"{asset} / {joint}" if joint else f"{asset} (position)")
+
+    def refresh_values(self) -> None:
+        if self._editing:
+            return
+        self.rebuild()
+
+    def key(self, spec: DofSpec, value: float, gesture: object) -> None:
+        self._editing = True
+        try:
+            self.ctx.push(spec.make(value, self.ctx.time, gesture))
+        finally:
+            self._editing = False
+
+
+class JointTree(QTreeWidget):
+    """Assets and their joint hierarchies."""
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("jointTree")
+        self.ctx = ctx
+        self.setHeaderHidden(True)
+        self.setColumnCount(1)
+        self.icons = {k: _icon(k) for k in ("dynamic", "keyed", "key", "character", "skeleton")}
+        self._items: dict[tuple[str, str], QTreeWidgetItem] = {}
+        self._syncing = False
+        self.currentItemChanged.connect(self._current_changed)
+
+    def rebuild(self) -> None:
+        self._syncing = True
+        self.clear()
+        self._items.clear()
+        doc = self.ctx.doc
+        m2, m3 = c2d(), c3d()
+        kinds = {m.ASSET_KIND for m in (m2, m3) if m is not None}
+        for aid, asset in doc.assets.items():
+            if asset.kind not in kinds:
+                continue
+            top = QTreeWidgetItem([aid])
+            top.setData(0, ROLE, (aid, ""))
+            top.setIcon(0, self.icons["character" if m2 is not None and asset.kind == m2.ASSET_KIND
+                                      else "skeleton"])
+            self.addTopLevelItem(top)
+            self._items[(aid, "")] = top
+            items: list[QTreeWidgetItem] = []
+            for name, parent, _dynamic in joint_names(doc, aid):
+                item = QTreeWidgetItem([name])
+                item.setData(0, ROLE, (aid, name))
+                (items[parent] if parent is not None else top).addChild(item)
+                items.append(item)
+                self._items[(aid, name)] = item
+            top.setExpanded(True)
+            for item in items:
+                item.setExpanded(True)
+        self.refresh_icons()
+        self._syncing = False
+        self.follow_selection()
+
+    def refresh_icons(self) -> None:
+        doc = self.ctx.doc
+        keyed: set[tuple[str, str]] = set()
+        for cid, ch in doc.channels.items():
+            if ch.keys:
+                a, j, _dof = split_channel_id(cid)
+                keyed.add((a, j))
+        for aid in {k[0] for k in self._items}:
+            for name, _parent, dynamic in joint_names(doc, aid):
+                item = self._items.get((aid, name))
+                if item is None:
+                    continue
+                kind = "dynamic" if dynamic else ("keyed" if (aid, name) in keyed else "key")
+                item.setIcon(0, self.icons[kind])
+                item.setToolTip(0, {"dynamic": "dynamic joint (pendulum)", "keyed": "keyframed joint (has keys)",
+                                    "key": "keyframed joint"}[kind])
+
+    def item_for(self, asset: str, joint: str) -> QTreeWidgetItem | None:
+        return self._items.get((asset, joint))
+
+    def follow_selection(self) -> None:
+        item = self.item_for(*self.ctx.selection)
+        self._syncing = True
+        self.setCurrentItem(item)  # type: ignore[arg-type]
+        if item is None:
+            self.clearSelection()
+        else:
+            self.scrollToItem(item)
+        self._syncing = False
+
+    def _current_changed(self, current: QTreeWidgetItem | None, _previous: QTreeWidgetItem | None) -> None:
+        if self._syncing or current is None:
+            return
+        asset, joint = current.data(0, ROLE)
+        self.ctx.select(asset, joint)
+
+    def step_joint(self, delta: int) -> None:
+        """Select the next / previous joint of the selected asset (pre-order, wrapping)."""
+        asset, joint = self.ctx.selection
+        if not asset:
+            return
+        names = [""] + [n for n, _p, _d in joint_names(self.ctx.doc, asset)]
+        i = names.index(joint) if joint in names else 0
+        self.ctx.select(asset, names[(i + delta) % len(names)])
+
+
+class JointTreePanel(QWidget):
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("jointTreePanel")
+        self.ctx = ctx
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        self.tree = JointTree(ctx, self)
+        self.dofs = DofPanel(ctx, self)
+        layout.addWidget(self.tree, 3)
+        layout.addWidget(self.dofs, 1)
+        self.dofs.prev_button.clicked.connect(lambda: self.tree.step_joint(-1))
+        self.dofs.next_button.clicked.connect(lambda: self.tree.step_joint(1))
+        self.dofs.reset_button.clicked.connect(self.reset_pose)
+        ctx.selectionChanged.connect(self._selection_changed)
+        ctx.documentChanged.connect(self._document_changed)
+        ctx.documentReset.connect(self._reset)
+        ctx.frameChanged.connect(lambda _f: self.dofs.refresh_values())
+        self._reset()
+
+    def _reset(self) -> None:
+        self.tree.rebuild()
+        self.dofs.rebuild()
+
+    def _selection_changed(self, _asset: str, _joint: str) -> None:
+        self.tree.follow_selection()
+        self.dofs.rebuild()
+
+    def _document_changed(self, event: ChangeEvent) -> None:
+        if event.kind == "asset":
+            self.tree.rebuild()
+            self.dofs.rebuild()
+        elif event.kind == "channel":
+            self.tree.refresh_icons()
+            self.dofs.refresh_values()
+        elif event.kind == "parameter":
+            self.dofs.refresh_values()
+
+    def reset_pose(self) -> None:
+        asset = self.ctx.selection[0]
+        if not asset:
+            return
+        cmd = reset_pose_command(self.ctx.doc, asset, self.ctx.time)
+        if cmd is not None:
+            self.ctx.push(cmd)
+
+
+def install(window: MainWindow) -> None:
+    panel = JointTreePanel(window.ctx)
+    window.joint_tree = panel  # type: ignore[attr-defined]
+    window.add_dock("jointTreeDock", "Joints", panel, Qt.DockWidgetArea.LeftDockWidgetArea)
+    reset = QAction("Reset Pose", window)
+    reset.setObjectName("actionResetPose")
+    reset.setShortcut(QKeySequence("R"))
+    reset.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+    reset.triggered.connect(lambda _c=False: panel.reset_pose())
+    panel.addAction(reset)
+    window.reset_pose_action = reset  # type: ignore[attr-defined]
+    view = window.findChild(QWidget, "rigEditorView")
+    if view is not None:
+        view.addAction(reset)
+

@@ -1,0 +1,374 @@
+"""The properties dock: the selected joint and character, pendulum parameters, IK settings.
+
+Everything editable is a document parameter changed through a command (SetParameter, or
+``character2d.set_pendulum_preset`` for a preset), so it is undoable and saved with the
+project. Read-only facts (mass, inertia, pivot…) are shown as labels.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import fields
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from PySide6.QtCore import Qt
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDoubleSpinBox,
+    QFormLayout,
+    QGroupBox,
+    QLabel,
+    QScrollArea,
+    QSpinBox,
+    QVBoxLayout,
+    QWidget,
+)
+
+from qtanimator.document.commands import SetParameter
+from qtanimator.document.document import ChangeEvent
+from qtanimator.ui.context import EditorContext
+from qtanimator.ui.joint_tree import c2d, c3d
+from qtanimator.ui.rig_interaction import IK_DEFAULTS, ik_setting
+
+if TYPE_CHECKING:
+    from qtanimator.ui.main_window import MainWindow
+
+PENDULUM_LABELS = {
+    "g": "Gravity g (units/s²)",
+    "damping": "Damping a (1/s)",
+    "length_scale": "Length scale",
+    "accel_scale": "Translation accel. scale",
+    "rotation_accel_scale": "Rotation accel. scale",
+    "inertia": "Moments of inertia",
+    "point_mass_forcing": "Point-mass forcing (1/L²)",
+    "coupled": "Coupled chains",
+    "integrator": "Integrator",
+    "step": "Internal step (s)",
+}
+IK_LABELS = {
+    "ik.solver": "Solver",
+    "ik.freeze_root": "Freeze root",
+    "ik.max_iterations": "Max iterations",
+    "ik.damping": "DLS damping",
+    "ik.handout_step": "Handout step τ",
+    "ik.handout_iterations": "Handout steps per move",
+    "ik.gradient_arrow_scale": "Gradient arrow scale",
+}
+IK_CHOICES = {"ik.solver": ["dls", "handout"]}
+
+
+class PropertiesPanel(QWidget):
+    """A form rebuilt when the selection changes; values refresh on document events."""
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("propertiesPanel")
+        self.ctx = ctx
+        outer = QVBoxLayout(self)
+        outer.setContentsMargins(0, 0, 0, 0)
+        self.scroll = QScrollArea(self)
+        self.scroll.setWidgetResizable(True)
+        outer.addWidget(self.scroll)
+        self.body: QWidget | None = None
+        self._refreshers: list[Callable[[], None]] = []
+        self.editors: dict[str, QWidget] = {}
+        ctx.selectionChanged.connect(lambda _a, _j: self.rebuild())
+        ctx.documentReset.connect(self.rebuild)
+        ctx.documentChanged.connect(self._on_document)
+        ctx.frameChanged.connect(lambda _f: self.refresh())
+        self.rebuild()
+
+    # ------------------------------------------------------------ structure
+    def _on_document(self, event: ChangeEvent) -> None:
+        if event.kind == "asset":
+            self.rebuild()
+        else:
+            self.refresh()
+
+    def refresh(self) -> None:
+        for fn in self._refreshers:
+            fn()
+
+    def rebuild(self) -> None:
+        self._refreshers = []
+        self.editors = {}
+        body = QWidget()
+        layout = QVBoxLayout(body)
+        asset, joint = self.ctx.selection
+        doc = self.ctx.doc
+        m2, m3 = c2d(), c3d()
+        kind = doc.assets[asset].kind if asset in doc.assets else ""
+        if m2 is not None and kind == m2.ASSET_KIND and asset in doc.runtime:
+            if joint:
+                layout.addWidget(self._joint2d_group(asset, joint))
+            layout.addWidget(self._character2d_group(asset))
+            if bool(doc.runtime[asset].dynamic.any()):
+                layout.addWidget(self._pendulum_group(asset))
+        elif m3 is not None and kind == m3.ASSET_KIND and asset in doc.runtime:
+            layout.addWidget(self._joint3d_group(asset, joint))
+        elif not asset:
+            label = QLabel("Select a joint or a character.")
+            label.setObjectName("propertiesHint")
+            layout.addWidget(label)
+        layout.addWidget(self._ik_group())
+        layout.addStretch(1)
+        self.scroll.setWidget(body)  # deletes the previous body
+        self.body = body
+        self.refresh()
+
+    # -------------------------------------------------------------- helpers
+    def _label(self, form: QFormLayout, title: str, value: Callable[[], str], name: str) -> QLabel:
+        label = QLabel()
+        label.setObjectName(name)
+        label.setTextInteractionFlags(Qt.TextInteractionFlag.TextSelectableByMouse)
+        form.addRow(title, label)
+
+        def refresh() -> None:
+            try:
+                label.setText(value())
+            except (KeyError, IndexError, ValueError):
+                label.setText("—")
+
+        self._refreshers.append(refresh)
+        return label
+
+    def _parameter_editor(self, form: QFormLayout, title: str, path: str, default: Any,
+                          choices: list[str] | None = None, decimals: int = 4) -> QWidget:
+        """An editor for one document parameter; every change is a SetParameter."""
+        doc = self.ctx.doc
+        name = "param_" + path.replace(".", "_")
+
+        def current() -> Any:
+            return doc.parameter(path, default)
+
+        def push(value: Any) -> None:
+            if current() != value:
+                self.ctx.push(SetParameter(doc, path, value, text=f"Set {title}", gesture=("properties", path,
+                                                                                           object())))
+
+        widget: QWidget
+        if choices is not None:
+            combo = QComboBox()
+            combo.addItems(choices)
+            combo.currentTextChanged.connect(push)
+
+            def refresh_combo() -> None:
+                combo.blockSignals(True)
+                combo.setCurrentText(str(current()))
+                combo.blockSignals(False)
+
+            self._refreshers.append(refresh_combo)
+            widget = combo
+        elif isinstance(default, bool):
+            box = QCheckBox()
+            box.toggled.connect(lambda on: push(bool(on)))
+
+            def refresh_check() -> None:
+                box.blockSignals(True)
+                box.setChecked(bool(current()))
+                box.blockSignals(False)
+
+            self._refreshers.append(refresh_check)
+            widget = box
+        elif isinstance(default, int):
+            spin = QSpinBox()
+            spin.setRange(0, 1_000_000)
+            spin.setKeyboardTracking(False)
+            spin.valueChanged.connect(lambda v: push(int(v)))
+
+            def refresh_int() -> None:
+                spin.blockSignals(True)
+                spin.setValue(int(current()))
+                spin.blockSignals(False)
+
+            self._refreshers.append(refresh_int)
+            widget = spin
+        else:
+            dspin = QDoubleSpinBox()
+            dspin.setDecimals(decimals if abs(float(default)) >= 1e-3 or default == 0 else 9)
+            dspin.setRange(-1e9, 1e9)
+            dspin.setKeyboardTracking(False)
+            magnitude = abs(float(default)) or 1.0
+            dspin.setSingleStep(10 ** math.floor(math.log10(magnitude)))
+            dspin.valueChanged.connect(lambda v: push(float(v)))
+
+            def refresh_float() -> None:
+                dspin.blockSignals(True)
+                dspin.setValue(float(current()))
+                dspin.blockSignals(False)
+
+            self._refreshers.append(refresh_float)
+            widget = dspin
+        widget.setObjectName(name)
+        self.editors[path] = widget
+        form.addRow(title, widget)
+        return widget
+
+    # ---------------------------------------------------------------- groups
+    def _joint2d_group(self, asset: str, joint: str) -> QGroupBox:
+        doc = self.ctx.doc
+        m2 = c2d()
+        assert m2 is not None
+        character = doc.runtime[asset]
+        index = character.joint_index(joint)
+        j = character.joints[index]
+        group = QGroupBox(f"Joint: {joint}")
+        group.setObjectName("jointProperties")
+        form = QFormLayout(group)
+        form.addRow("Index", QLabel(str(index)))
+        parent = "—" if j.parent is None else character.joints[j.parent].name
+        form.addRow("Parent", QLabel(parent))
+        kind = QLabel("dynamic (pendulum)" if j.is_dynamic else "keyframed")
+        kind.setObjectName("jointType")
+        form.addRow("Type", kind)
+        form.addRow("Pivot (rest)", QLabel(f"({j.pivot[0]:.2f}, {j.pivot[1]:.2f})"))
+        form.addRow("Shapes", QLabel(str(len(j.shapes))))
+        form.addRow("Mass", QLabel(f"{j.mass:.6g}"))
+        form.addRow("Moment of inertia", QLabel(f"{j.inertia:.6g}"))
+        com = j.centroid
+        form.addRow("Centre of mass", QLabel(f"({com[0]:.2f}, {com[1]:.2f})"))
+        form.addRow("Pendulum length L", QLabel(f"{float(np.hypot(*(com - j.pivot))):.3f}"))
+
+        def angle() -> str:
+            a = float(np.asarray(m2.joint_angles(doc, asset, self.ctx.time))[index])
+            return f"{math.degrees(a):.3f}°"
+
+        self._label(form, "Angle (local)", angle, "jointAngle")
+        return group
+
+    def _character2d_group(self, asset: str) -> QGroupBox:
+        doc = self.ctx.doc
+        m2 = c2d()
+        assert m2 is not None
+        character = doc.runtime[asset]
+        group = QGroupBox(f"Character: {asset}")
+        group.setObjectName("characterProperties")
+        form = QFormLayout(group)
+        source = doc.assets[asset].source
+        src = QLabel(Path(source).name if source else "—")
+        src.setToolTip(source or "")
+        form.addRow("Source", src)
+        form.addRow("Joints", QLabel(f"{len(character.joints)} ({int(character.dynamic.sum())} dynamic)"))
+        mass = sum(j.mass for j in character.joints)
+        form.addRow("Total mass", QLabel(f"{mass:.6g}"))
+
+        def position() -> str:
+            t = m2.translation(doc, asset, self.ctx.time)
+            return f"({t[0]:.2f}, {t[1]:.2f})"
+
+        def velocity() -> str:
+            t = m2.translation(doc, asset, self.ctx.time, 1)
+            return f"({t[0]:.2f}, {t[1]:.2f}) /s"
+
+        self._label(form, "Position", position, "characterPosition")
+        self._label(form, "Velocity", velocity, "characterVelocity")
+        key_all = getattr(m2, "KEY_ALL_PARAMETER", "animation.key_all")
+        self._parameter_editor(form, "Key every joint (universal keyframe)", key_all, False)
+        return group
+
+    def _pendulum_group(self, asset: str) -> QGroupBox:
+        doc = self.ctx.doc
+        m2 = c2d()
+        assert m2 is not None
+        from qtanimator.core.pendulum import INTEGRATORS, PRESETS, PendulumParams
+
+        group = QGroupBox("Pendulums")
+        group.setObjectName("pendulumProperties")
+        form = QFormLayout(group)
+        preset = QComboBox()
+        preset.setObjectName("pendulumPreset")
+        preset.addItems(list(PRESETS))
+        preset.addItem("custom")
+
+        def current_preset() -> str:
+            params = m2.pendulum_params(doc, asset)
+            for name, p in PRESETS.items():
+                if p == params:
+                    return name
+            return "custom"
+
+        def apply_preset(name: str) -> None:
+            if name in PRESETS and name != current_preset():
+                self.ctx.push(m2.set_pendulum_preset(doc, asset, name))
+
+        def refresh_preset() -> None:
+            preset.blockSignals(True)
+            preset.setCurrentText(current_preset())
+            preset.blockSignals(False)
+
+        preset.currentTextChanged.connect(apply_preset)
+        self._refreshers.append(refresh_preset)
+        self.editors["preset"] = preset
+        form.addRow("Preset", preset)
+        defaults = PendulumParams()
+        for f in fields(PendulumParams):
+            path = f"{asset}.pendulum.{f.name}"
+            default = getattr(m2.pendulum_params(doc, asset), f.name)
+            choices = None
+            if f.name == "inertia":
+                choices = ["exact", "reference"]
+            elif f.name == "integrator":
+                choices = list(INTEGRATORS)
+            editor = self._parameter_editor(form, PENDULUM_LABELS.get(f.name, f.name), path, default, choices,
+                                            decimals=6)
+            editor.setToolTip(f"default {getattr(defaults, f.name)!r}")
+            # What is shown is the effective value (preset + overrides).
+            self._refreshers.append(self._effective_refresher(editor, asset, f.name))
+        return group
+
+    def _effective_refresher(self, editor: QWidget, asset: str, name: str) -> Callable[[], None]:
+        m2 = c2d()
+        assert m2 is not None
+        doc = self.ctx.doc
+
+        def refresh() -> None:
+            value = getattr(m2.pendulum_params(doc, asset), name)
+            editor.blockSignals(True)
+            if isinstance(editor, QComboBox):
+                editor.setCurrentText(str(value))
+            elif isinstance(editor, QCheckBox):
+                editor.setChecked(bool(value))
+            elif isinstance(editor, QDoubleSpinBox):
+                editor.setValue(float(value))
+            editor.blockSignals(False)
+
+        return refresh
+
+    def _joint3d_group(self, asset: str, joint: str) -> QGroupBox:
+        doc = self.ctx.doc
+        group = QGroupBox(f"Joint: {joint}" if joint else f"Skeleton: {asset}")
+        group.setObjectName("jointProperties")
+        form = QFormLayout(group)
+        runtime = doc.runtime[asset]
+        skeleton = getattr(runtime, "skeleton", runtime)
+        names = [j.name for j in skeleton.joints]
+        if joint in names:
+            j = skeleton.joints[names.index(joint)]
+            form.addRow("Offset", QLabel("({:.3f}, {:.3f}, {:.3f})".format(*(float(v) for v in j.offset))))
+            for axis, dof in zip("xyz", j.dofs):
+                form.addRow(f"Limits {axis}", QLabel(f"{math.degrees(dof.min):.1f}° … {math.degrees(dof.max):.1f}°"))
+        else:
+            form.addRow("Joints", QLabel(str(len(names))))
+        return group
+
+    def _ik_group(self) -> QGroupBox:
+        group = QGroupBox("IK solver")
+        group.setObjectName("ikProperties")
+        form = QFormLayout(group)
+        for path, default in IK_DEFAULTS.items():
+            self._parameter_editor(form, IK_LABELS.get(path, path), path, default, IK_CHOICES.get(path),
+                                   decimals=6)
+        return group
+
+
+def install(window: MainWindow) -> None:
+    panel = PropertiesPanel(window.ctx)
+    window.properties_panel = panel  # type: ignore[attr-defined]
+    window.add_dock("propertiesDock", "Properties", panel, Qt.DockWidgetArea.RightDockWidgetArea)
+
+
+__all__ = ["PropertiesPanel", "install", "ik_setting"]

@@ -1,0 +1,810 @@
+"""The 2D rig editor: a QGraphicsScene of the document's 2D characters.
+
+Mouse (the reference animator's, plus a view you can move):
+
+* hover highlights the joint under the cursor; a click selects it (``ctx.select``);
+* left-drag on a joint rotates it about its pivot, on the root moves the character;
+* right-drag pulls the picked point towards the cursor with IK (or, with *IK toggle mode*,
+  the reference's toggle: right-press starts following the cursor, the next press stops);
+* every drag is one undo step; Escape takes the drag back;
+* middle-drag pans, the wheel zooms about the cursor, F fits the scene in the view.
+
+Keys: Delete / Backspace delete the keys at the current frame; ``d`` toggles the debug
+overlays (the character's path with velocity (blue) and acceleration (red) arrows at its
+keys, the IK source (red) / target (blue) dots and gradient arrows, and the HUD).
+Onion skin: ghosts of earlier / later frames, with counts, step and tints.
+
+The gesture logic lives in :mod:`qtanimator.ui.rig_interaction` (no Qt).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtGui import (
+    QAction,
+    QBrush,
+    QColor,
+    QFont,
+    QFontMetricsF,
+    QImage,
+    QKeyEvent,
+    QKeySequence,
+    QMouseEvent,
+    QPainter,
+    QPainterPath,
+    QPen,
+    QPolygonF,
+    QWheelEvent,
+)
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QColorDialog,
+    QGraphicsItem,
+    QGraphicsScene,
+    QGraphicsView,
+    QLabel,
+    QSpinBox,
+    QStyleOptionGraphicsItem,
+    QToolBar,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from qtanimator.document.commands import Command
+from qtanimator.document.document import ChangeEvent
+from qtanimator.ui import rig_interaction as ri
+from qtanimator.ui.context import EditorContext
+
+if TYPE_CHECKING:
+    from qtanimator.ui.main_window import MainWindow
+
+#: The reference program's window colour (0.6, 0.6, 0.9).
+BACKGROUND = QColor(153, 153, 230)
+SCENE_LIMIT = 1.0e5
+ZOOM_PER_DEGREE = 1.0015  # per wheel unit (1/8 degree)
+_gesture_ids = itertools.count(1)
+
+
+def _c2d() -> Any:
+    from qtanimator.document import character2d
+
+    return character2d
+
+
+def _painter2d() -> Any:
+    from qtanimator.render import painter2d
+
+    return painter2d
+
+
+class JointSprites:
+    """Each joint's shapes rendered once into an image at the view's scale.
+
+    While playing, the editor draws a joint as its image under the joint's world transform
+    (a transformed blit) instead of filling and stroking every path again: several times
+    faster on big rigs. The images are rebuilt when the zoom changes or when a joint's
+    highlight changes; a still frame is always drawn as vectors.
+    """
+
+    PAD = 2.0
+    MAX_PIXELS = 2048 * 2048
+
+    def __init__(self) -> None:
+        self._scale = 0.0
+        self._images: dict[tuple[int, int, str], tuple[QImage, QRectF] | None] = {}
+
+    def clear(self) -> None:
+        self._images.clear()
+
+    def _build(self, character: Any, index: int, state: str, scale: float) -> tuple[QImage, QRectF] | None:
+        from dataclasses import replace
+
+        from qtanimator.core.rig2d import Character
+
+        joint = character.joints[index]
+        boxes = [s.bounds() for s in joint.shapes]
+        x0 = min(b[0] for b in boxes) - self.PAD / scale
+        y0 = min(b[1] for b in boxes) - self.PAD / scale
+        x1 = max(b[2] for b in boxes) + self.PAD / scale
+        y1 = max(b[3] for b in boxes) + self.PAD / scale
+        w, h = int(math.ceil((x1 - x0) * scale)), int(math.ceil((y1 - y0) * scale))
+        if w <= 0 or h <= 0 or w * h > self.MAX_PIXELS:
+            return None
+        image = QImage(w, h, QImage.Format.Format_ARGB32_Premultiplied)
+        image.fill(0)
+        single = Character(joint.name, [replace(joint, parent=None, children=[])])
+        painter = QPainter(image)
+        painter.scale(scale, scale)
+        painter.translate(-x0, -y0)
+        _painter2d().draw_character(painter, single, single.rest_pose(),
+                                    highlight=0 if state == "selected" else None,
+                                    hover=0 if state == "hover" else None)
+        painter.end()
+        return image, QRectF(x0, y0, w / scale, h / scale)
+
+    def draw(self, painter: QPainter, character: Any, pose: Any, highlight: int | None,
+             hover: int | None) -> None:
+        base = painter.worldTransform()
+        scale = math.hypot(base.m11(), base.m12()) * painter.device().devicePixelRatioF()
+        if abs(scale - self._scale) > 1e-3 * max(scale, 1e-9):
+            self._images.clear()
+            self._scale = scale
+        p2d = _painter2d()
+        painter.save()
+        painter.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, True)
+        cid = id(character)
+        for i, joint in enumerate(character.joints):
+            if not joint.shapes:
+                continue
+            state = "selected" if i == highlight else ("hover" if i == hover else "")
+            key = (cid, i, state)
+            if key not in self._images:
+                self._images[key] = self._build(character, i, state, scale)
+            sprite = self._images[key]
+            painter.setWorldTransform(p2d.joint_transform(pose, i) * base)
+            if sprite is None:
+                painter.restore()
+                p2d.draw_character(painter, character, pose, highlight=highlight, hover=hover)
+                return
+            painter.drawImage(sprite[1], sprite[0])
+        painter.restore()
+
+
+class CharacterItem(QGraphicsItem):
+    """One 2D character, drawn with the shared renderer in scene (SVG) units."""
+
+    def __init__(self, editor: RigEditorView, asset: str) -> None:
+        super().__init__()
+        self.editor = editor
+        self.asset = asset
+        self.setFlag(QGraphicsItem.GraphicsItemFlag.ItemUsesExtendedStyleOption, False)
+
+    def boundingRect(self) -> QRectF:
+        # Poses change every frame; the view repaints fully, so a generous box is cheaper
+        # than recomputing bounds of every posed shape.
+        return QRectF(-SCENE_LIMIT, -SCENE_LIMIT, 2 * SCENE_LIMIT, 2 * SCENE_LIMIT)
+
+    def paint(self, painter: QPainter, _option: QStyleOptionGraphicsItem, _widget: QWidget | None = None) -> None:
+        doc = self.editor.ctx.doc
+        character = doc.runtime.get(self.asset)
+        pose = self.editor.poses().get(self.asset)
+        if character is None or pose is None:
+            return
+        highlight = self.editor.selected_joint_index(self.asset)
+        hover = self.editor.hover[1] if self.editor.hover and self.editor.hover[0] == self.asset else None
+        if self.editor.use_sprites():
+            self.editor.sprites.draw(painter, character, pose, highlight, hover)
+        else:
+            _painter2d().draw_character(painter, character, pose, highlight=highlight, hover=hover)
+
+
+class RigEditorView(QGraphicsView):
+    """The view; it owns the interaction state and the overlays."""
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("rigEditorView")
+        self.ctx = ctx
+        self._scene = QGraphicsScene(self)
+        self._scene.setObjectName("rigEditorScene")
+        self._scene.setSceneRect(-SCENE_LIMIT, -SCENE_LIMIT, 2 * SCENE_LIMIT, 2 * SCENE_LIMIT)
+        self._scene.setItemIndexMethod(QGraphicsScene.ItemIndexMethod.NoIndex)
+        self.setScene(self._scene)
+        self.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+        self.setViewportUpdateMode(QGraphicsView.ViewportUpdateMode.FullViewportUpdate)
+        self.setHorizontalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.setVerticalScrollBarPolicy(Qt.ScrollBarPolicy.ScrollBarAlwaysOff)
+        self.setTransformationAnchor(QGraphicsView.ViewportAnchor.NoAnchor)
+        self.setResizeAnchor(QGraphicsView.ViewportAnchor.AnchorViewCenter)
+        self.setMouseTracking(True)
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        self.setBackgroundBrush(QBrush(BACKGROUND))
+        self.items_by_asset: dict[str, CharacterItem] = {}
+        self.hover: tuple[str, int] | None = None
+        self.debug = False
+        self.onion = ri.OnionSettings()
+        self.ik_toggle_mode = False
+        self.frames_drawn = 0
+        self.playing = False
+        #: "playing" (sprites while playing), "always" or "never".
+        self.sprite_mode = "playing"
+        self.sprites = JointSprites()
+        # Interaction state.
+        self._drag: Any = None
+        self._gesture: ri.Gesture | None = None
+        self._drag_button: Qt.MouseButton | None = None
+        self._ik: tuple[str, int, np.ndarray] | None = None  # asset, joint, rest-pose source point
+        self._ik_target: np.ndarray | None = None
+        self._ik_following = False
+        self._pan_from: QPointF | None = None
+        self._poses: dict[str, Any] | None = None
+        self._revision = 0
+        self._path_cache: dict[tuple[str, int, int, int], np.ndarray] = {}
+        self._fitted = False
+        self._auto_fit = False
+        ctx.frameChanged.connect(self._on_frame)
+        ctx.documentChanged.connect(self._on_document)
+        ctx.documentReset.connect(self._on_reset)
+        ctx.selectionChanged.connect(lambda _a, _j: self.viewport().update())
+        ctx.playingChanged.connect(self._on_playing)
+        self._sync_items()
+
+    def _on_playing(self, playing: bool) -> None:
+        self.playing = playing
+        if not playing:
+            self.viewport().update()  # the still frame is drawn as vectors again
+
+    def use_sprites(self) -> bool:
+        return self.sprite_mode == "always" or (self.sprite_mode == "playing" and self.playing)
+
+    # ------------------------------------------------------------------ state
+    def character_ids(self) -> list[str]:
+        try:
+            return ri.character_ids(self.ctx.doc)
+        except ModuleNotFoundError:
+            return []
+
+    def poses(self) -> dict[str, Any]:
+        """The posed characters at the current frame (computed once per change)."""
+        if self._poses is None:
+            c2d = _c2d()
+            t = self.ctx.time
+            self._poses = {aid: c2d.evaluate_pose(self.ctx.doc, aid, t) for aid in self.character_ids()}
+        return self._poses
+
+    def selected_joint_index(self, asset: str) -> int | None:
+        sel_asset, joint = self.ctx.selection
+        if sel_asset != asset:
+            return None
+        character = self.ctx.doc.runtime.get(asset)
+        if character is None:
+            return None
+        if joint == "":
+            return 0
+        try:
+            return int(character.joint_index(joint))
+        except KeyError:
+            return None
+
+    def _invalidate(self) -> None:
+        self._poses = None
+        self._revision += 1
+        self.viewport().update()
+
+    def _on_frame(self, _frame: float) -> None:
+        self._poses = None
+        self.viewport().update()
+
+    def _on_document(self, event: ChangeEvent) -> None:
+        if event.kind == "asset":
+            self.sprites.clear()
+            self._sync_items()
+            if self.ctx.selection[0] and self.ctx.selection[0] not in self.ctx.doc.assets:
+                self.ctx.select("", "")
+            if self.hover is not None and self.hover[0] not in self.ctx.doc.assets:
+                self.hover = None
+            if not self._fitted:
+                self.fit_view()
+        self._invalidate()
+
+    def _on_reset(self) -> None:
+        self.sprites.clear()
+        self.abort_drag()
+        self.hover = None
+        self._path_cache.clear()
+        self._sync_items()
+        self._fitted = False
+        self.fit_view()
+        self._invalidate()
+
+    def _sync_items(self) -> None:
+        ids = self.character_ids()
+        for aid in list(self.items_by_asset):
+            if aid not in ids:
+                self._scene.removeItem(self.items_by_asset.pop(aid))
+        for z, aid in enumerate(ids):
+            item = self.items_by_asset.get(aid)
+            if item is None:
+                item = CharacterItem(self, aid)
+                self.items_by_asset[aid] = item
+                self._scene.addItem(item)
+            item.setZValue(z)
+        self._poses = None
+
+    # ------------------------------------------------------------------- view
+    def scene_bounds(self) -> QRectF:
+        if not self.character_ids():
+            return QRectF()
+        return _painter2d().scene_bounds(self.ctx.doc, self.ctx.time)
+
+    def fit_view(self) -> None:
+        rect = self.scene_bounds()
+        if rect.isEmpty():
+            return
+        margin = 0.05 * max(rect.width(), rect.height())
+        self.fitInView(rect.adjusted(-margin, -margin, margin, margin), Qt.AspectRatioMode.KeepAspectRatio)
+        self._fitted = True
+        self._auto_fit = True  # follow window resizes until the user zooms or pans
+        self.viewport().update()
+
+    def to_scene(self, pos: QPointF) -> np.ndarray:
+        inverse, _ok = self.viewportTransform().inverted()
+        p = inverse.map(QPointF(pos))
+        return np.array([p.x(), p.y()])
+
+    def from_scene(self, xy: Any) -> QPointF:
+        return self.viewportTransform().map(QPointF(float(xy[0]), float(xy[1])))
+
+    def wheelEvent(self, event: QWheelEvent) -> None:
+        delta = event.angleDelta().y() or event.angleDelta().x()
+        if not delta:
+            return
+        factor = ZOOM_PER_DEGREE ** delta  # 120 per notch: × 1.2
+        anchor = self.to_scene(event.position())
+        self._auto_fit = False
+        self.scale(factor, factor)
+        # Keep the point under the cursor fixed.
+        moved = self.from_scene(anchor) - event.position()
+        self._pan_by(moved)
+        event.accept()
+
+    def resizeEvent(self, event: Any) -> None:
+        super().resizeEvent(event)
+        if self._auto_fit:
+            self.fit_view()
+
+    def _pan_by(self, delta: QPointF) -> None:
+        h, v = self.horizontalScrollBar(), self.verticalScrollBar()
+        h.setValue(h.value() + int(round(delta.x())))
+        v.setValue(v.value() + int(round(delta.y())))
+
+    # ------------------------------------------------------------------ mouse
+    def _new_gesture(self, text: str) -> ri.Gesture:
+        return ri.Gesture(self.ctx.doc, ("rig-editor", next(_gesture_ids)), text)
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        button = event.button()
+        if button == Qt.MouseButton.MiddleButton:
+            self._pan_from = event.position()
+            self._auto_fit = False
+            self.setCursor(Qt.CursorShape.ClosedHandCursor)
+            event.accept()
+            return
+        if self._ik_following and button in (Qt.MouseButton.LeftButton, Qt.MouseButton.RightButton):
+            self.finish_drag()  # the toggle's second press (or a left press) ends it
+            if button == Qt.MouseButton.RightButton:
+                event.accept()
+                return
+        if self._drag is not None:
+            event.accept()
+            return
+        point = self.to_scene(event.position())
+        time = self.ctx.time
+        try:
+            hit = ri.pick(self.ctx.doc, time, point)
+        except ModuleNotFoundError:
+            hit = None
+        if hit is not None and button in (Qt.MouseButton.LeftButton, Qt.MouseButton.RightButton):
+            # Keys go to the frame under the cursor: stop playback first.
+            playback = getattr(self.window(), "playback", None)
+            if playback is not None:
+                playback.pause()
+            time = self.ctx.time
+        if button == Qt.MouseButton.LeftButton:
+            if hit is None:
+                self.ctx.select("", "")
+                event.accept()
+                return
+            asset, joint = hit
+            character = self.ctx.doc.runtime[asset]
+            if joint == 0:
+                self.ctx.select(asset, "")
+                self._gesture = self._new_gesture(f"Move {asset}")
+                self._drag = ri.move_drag(self.ctx.doc, asset, point, time, self._gesture.token)
+            else:
+                self.ctx.select(asset, character.joints[joint].name)
+                self._gesture = self._new_gesture(f"Rotate {character.joints[joint].name}")
+                self._drag = ri.rotate_drag(self.ctx.doc, asset, joint, point, time, self._gesture.token)
+            next(self._drag)
+            self._drag_button = button
+            event.accept()
+            return
+        if button == Qt.MouseButton.RightButton:
+            if hit is None:
+                event.accept()
+                return
+            asset, joint = hit
+            character = self.ctx.doc.runtime[asset]
+            self.ctx.select(asset, character.joints[joint].name if joint else "")
+            self._gesture = self._new_gesture("IK Drag")
+            self._drag = ri.ik_drag(self.ctx.doc, asset, joint, point, time, self._gesture.token)
+            next(self._drag)
+            self._ik = (asset, joint, ri.ik_source(self.ctx.doc, asset, joint, point, time))
+            self._ik_target = point
+            self._drag_button = button
+            self._ik_following = self.ik_toggle_mode
+            event.accept()
+            return
+        super().mousePressEvent(event)
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if self._pan_from is not None:
+            delta = event.position() - self._pan_from
+            self._pan_from = event.position()
+            self._pan_by(QPointF(-delta.x(), -delta.y()))
+            event.accept()
+            return
+        point = self.to_scene(event.position())
+        if self._drag is not None and (self._ik_following or (self._drag_button is not None
+                                                               and event.buttons() & self._drag_button)):
+            self.drag_to(point)
+            event.accept()
+            return
+        self._update_hover(point)
+        event.accept()
+
+    def drag_to(self, point: np.ndarray) -> None:
+        """Feed one cursor position (scene units) to the current drag."""
+        if self._drag is None or self._gesture is None:
+            return
+        if self._ik is not None:
+            self._ik_target = np.asarray(point, dtype=np.float64)
+        command = self._drag.send(point)
+        self._gesture.apply(command)
+        self._invalidate()
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        if event.button() == Qt.MouseButton.MiddleButton and self._pan_from is not None:
+            self._pan_from = None
+            self.unsetCursor()
+            event.accept()
+            return
+        if self._drag is not None and event.button() == self._drag_button and not self._ik_following:
+            self.finish_drag()
+            event.accept()
+            return
+        super().mouseReleaseEvent(event)
+
+    def finish_drag(self) -> None:
+        """End the drag: its folded command goes on the undo stack as one step."""
+        gesture = self._gesture
+        self._reset_drag()
+        if gesture is None:
+            return
+        command = gesture.finish()
+        if command is not None and not command.is_noop():
+            self.ctx.push(command)
+        elif command is not None:
+            command.undo(self.ctx.doc)
+        self._invalidate()
+
+    def abort_drag(self) -> None:
+        """Escape: take back everything the current drag did."""
+        gesture = self._gesture
+        self._reset_drag()
+        if gesture is not None:
+            gesture.abort()
+        self._invalidate()
+
+    def _reset_drag(self) -> None:
+        if self._drag is not None:
+            self._drag.close()
+        self._drag = None
+        self._gesture = None
+        self._drag_button = None
+        self._ik = None
+        self._ik_target = None
+        self._ik_following = False
+
+    @property
+    def dragging(self) -> bool:
+        return self._drag is not None
+
+    def _update_hover(self, point: np.ndarray) -> None:
+        try:
+            hit = ri.pick(self.ctx.doc, self.ctx.time, point)
+        except ModuleNotFoundError:
+            hit = None
+        if hit != self.hover:
+            self.hover = hit
+            self.viewport().update()
+
+    def leaveEvent(self, event: Any) -> None:
+        if self.hover is not None:
+            self.hover = None
+            self.viewport().update()
+        super().leaveEvent(event)
+
+    # ------------------------------------------------------------------- keys
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        key = event.key()
+        if key == Qt.Key.Key_Escape and self._drag is not None:
+            self.abort_drag()
+            event.accept()
+            return
+        if key in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace):
+            self.delete_keys()
+            event.accept()
+            return
+        if key == Qt.Key.Key_D and not event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier:
+            self.set_debug(not self.debug)
+            event.accept()
+            return
+        super().keyPressEvent(event)
+
+    def delete_keys(self) -> None:
+        """Delete / Backspace: remove the keys at the current frame from every character."""
+        if self._drag is not None:
+            return
+        command: Command | None = _c2d().delete_keys_at(self.ctx.doc, None, self.ctx.time)
+        if command is not None:
+            self.ctx.push(command)
+
+    def set_debug(self, on: bool) -> None:
+        self.debug = on
+        action = getattr(self, "debug_action", None)
+        if action is not None and action.isChecked() != on:
+            action.setChecked(on)
+        self.viewport().update()
+
+    # ---------------------------------------------------------------- drawing
+    def drawBackground(self, painter: QPainter, rect: QRectF) -> None:
+        painter.fillRect(rect, BACKGROUND)
+        ghosts = ri.onion_frames(self.ctx.frame, self.onion, *self.ctx.doc.frame_range)
+        if not ghosts:
+            return
+        c2d, p2d = _c2d(), _painter2d()
+        doc = self.ctx.doc
+        for frame, side, opacity in ghosts:
+            r, g, b = self.onion.before_tint if side == "before" else self.onion.after_tint
+            tint = QColor(r, g, b, 170)
+            t = doc.frame_to_time(frame)
+            for aid in self.character_ids():
+                p2d.draw_character(painter, doc.runtime[aid], c2d.evaluate_pose(doc, aid, t), tint=tint,
+                                   opacity=opacity)
+
+    def drawForeground(self, painter: QPainter, rect: QRectF) -> None:
+        self.frames_drawn += 1
+        if not self.debug:
+            return
+        ids = self.character_ids()
+        if not ids:
+            return
+        self._draw_paths(painter, ids)
+        self._draw_ik(painter)
+        self._draw_hud(painter)
+
+    def _cosmetic(self, color: QColor, width: float) -> QPen:
+        pen = QPen(color, width)
+        pen.setCosmetic(True)
+        pen.setCapStyle(Qt.PenCapStyle.RoundCap)
+        return pen
+
+    def _arrow(self, painter: QPainter, start: Any, vec: Any, color: QColor) -> None:
+        a = QPointF(float(start[0]), float(start[1]))
+        b = QPointF(float(start[0] + vec[0]), float(start[1] + vec[1]))
+        painter.setPen(self._cosmetic(color, 2.0))
+        painter.drawLine(a, b)
+        length = math.hypot(float(vec[0]), float(vec[1]))
+        if length < 1e-9:
+            return
+        scale = 1.0 / max(self.transform().m11(), 1e-9)
+        head = 8.0 * scale
+        ux, uy = vec[0] / length, vec[1] / length
+        left = QPointF(b.x() - head * (ux + 0.5 * uy), b.y() - head * (uy - 0.5 * ux))
+        right = QPointF(b.x() - head * (ux - 0.5 * uy), b.y() - head * (uy + 0.5 * ux))
+        painter.setBrush(color)
+        painter.drawPolygon(QPolygonF([b, left, right]))
+
+    def _dot(self, painter: QPainter, xy: Any, diameter_px: float, color: QColor) -> None:
+        r = diameter_px / 2.0 / max(self.transform().m11(), 1e-9)
+        painter.setPen(Qt.PenStyle.NoPen)
+        painter.setBrush(color)
+        painter.drawEllipse(QPointF(float(xy[0]), float(xy[1])), r, r)
+
+    def _draw_paths(self, painter: QPainter, ids: list[str]) -> None:
+        doc = self.ctx.doc
+        first, last = doc.frame_range
+        selected = self.ctx.selection[0]
+        fps = doc.fps
+        for aid in ids:
+            key = (aid, self._revision, first, last)
+            pts = self._path_cache.get(key)
+            if pts is None:
+                pts = ri.character_path(doc, aid, np.arange(first, last + 1, dtype=np.float64))
+                self._path_cache = {k: v for k, v in self._path_cache.items() if k[1] == self._revision}
+                self._path_cache[key] = pts
+            path = QPainterPath()
+            path.addPolygon(QPolygonF([QPointF(float(x), float(y)) for x, y in pts]))
+            painter.setOpacity(1.0 if aid == selected else 0.2)
+            painter.setPen(self._cosmetic(QColor(255, 255, 255), 3.0))
+            painter.setBrush(Qt.BrushStyle.NoBrush)
+            painter.drawPath(path)
+            painter.setOpacity(1.0)
+            if aid != selected:
+                continue
+            current = ri.character_path(doc, aid, [self.ctx.frame])[0]
+            self._dot(painter, current, 15.0, QColor(0, 0, 0))
+            for k in ri.path_keys(doc, aid):
+                self._dot(painter, k.position, 10.0, QColor(255, 255, 255))
+                # The reference draws 5 × the per-frame derivatives.
+                self._arrow(painter, k.position, 5.0 * k.velocity / fps, QColor(0, 0, 255))
+                self._arrow(painter, k.position, 5.0 * k.acceleration / (fps * fps), QColor(255, 0, 0))
+
+    def _draw_ik(self, painter: QPainter) -> None:
+        if self._ik is None or self._ik_target is None:
+            return
+        asset, joint, local = self._ik
+        doc = self.ctx.doc
+        character = doc.runtime.get(asset)
+        pose = self.poses().get(asset)
+        if character is None or pose is None:
+            return
+        from qtanimator.core.ik import handout_gradient
+
+        gradient = handout_gradient(character, pose, joint, local, self._ik_target)
+        scale = float(ri.ik_setting(doc, "ik.gradient_arrow_scale"))
+        for start, end in ri.gradient_arrows(character, pose, gradient, scale):
+            self._arrow(painter, start, end - start, QColor(255, 220, 0))
+        self._dot(painter, pose.to_world(joint, local), 12.0, QColor(255, 0, 0))
+        self._dot(painter, self._ik_target, 25.0, QColor(0, 0, 255, 200))
+
+    def hud_text(self) -> list[str]:
+        asset, _joint = self.ctx.selection
+        if not asset or asset not in self.ctx.doc.runtime:
+            return []
+        return ri.hud_lines(self.ctx.doc, asset, self.selected_joint_index(asset), self.ctx.time)
+
+    def _draw_hud(self, painter: QPainter) -> None:
+        lines = self.hud_text()
+        if not lines:
+            return
+        painter.save()
+        painter.resetTransform()
+        font = QFont("monospace")
+        font.setStyleHint(QFont.StyleHint.TypeWriter)
+        font.setPointSizeF(9.0)
+        painter.setFont(font)
+        fm = QFontMetricsF(font)
+        width = max(fm.horizontalAdvance(s) for s in lines) + 16
+        height = fm.lineSpacing() * len(lines) + 12
+        box = QRectF(self.viewport().width() - width - 10, 10, width, height)
+        painter.setOpacity(0.8)
+        painter.fillRect(box, QColor(0, 0, 0))
+        painter.setOpacity(1.0)
+        painter.setPen(QColor(255, 255, 255))
+        y = box.top() + 6 + fm.ascent()
+        for s in lines:
+            painter.drawText(QPointF(box.left() + 8, y), s)
+            y += fm.lineSpacing()
+        painter.restore()
+
+
+class RigEditor(QWidget):
+    """The view with its tool bar (fit, debug, onion skin, IK mode)."""
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("rigEditor")
+        self.view = RigEditorView(ctx, self)
+        self.toolbar = QToolBar("2D Editor", self)
+        self.toolbar.setObjectName("rigEditorToolBar")
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.setSpacing(0)
+        layout.addWidget(self.toolbar)
+        layout.addWidget(self.view, 1)
+        view = self.view
+
+        self.fit_action = QAction("Fit View", self)
+        self.fit_action.setObjectName("actionFitView")
+        self.fit_action.setShortcut(QKeySequence("F"))
+        self.fit_action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+        self.fit_action.triggered.connect(lambda _c=False: view.fit_view())
+        self.debug_action = QAction("Debug Overlays", self)
+        self.debug_action.setObjectName("actionDebugOverlays")
+        self.debug_action.setCheckable(True)
+        self.debug_action.setToolTip("Paths, velocity / acceleration arrows, IK arrows and the HUD (d)")
+        self.debug_action.toggled.connect(view.set_debug)
+        view.debug_action = self.debug_action  # type: ignore[attr-defined]
+        self.toolbar.addAction(self.fit_action)
+        self.toolbar.addAction(self.debug_action)
+        self.addAction(self.fit_action)
+
+        self.toolbar.addSeparator()
+        self.onion_box = QCheckBox("Onion skin", self)
+        self.onion_box.setObjectName("onionSkinCheck")
+        self.toolbar.addWidget(self.onion_box)
+        self.before_box = self._spin("onionBefore", "earlier", 0, 20, view.onion.before)
+        self.after_box = self._spin("onionAfter", "later", 0, 20, view.onion.after)
+        self.step_box = self._spin("onionStep", "step", 1, 100, view.onion.step)
+        self.before_tint = self._tint_button("onionBeforeTint", "before_tint")
+        self.after_tint = self._tint_button("onionAfterTint", "after_tint")
+        for w in (self.onion_box,):
+            w.toggled.connect(lambda _v: self._onion_changed())
+        for box in (self.before_box, self.after_box, self.step_box):
+            box.valueChanged.connect(lambda _v: self._onion_changed())
+
+        self.toolbar.addSeparator()
+        self.ik_toggle_box = QCheckBox("IK toggle mode", self)
+        self.ik_toggle_box.setObjectName("ikToggleModeCheck")
+        self.ik_toggle_box.setToolTip("Right-click starts following the cursor, the next click stops "
+                                      "(the reference animator's IK)")
+        self.ik_toggle_box.toggled.connect(lambda on: setattr(view, "ik_toggle_mode", on))
+        self.toolbar.addWidget(self.ik_toggle_box)
+
+    def _spin(self, name: str, label: str, lo: int, hi: int, value: int) -> QSpinBox:
+        self.toolbar.addWidget(QLabel(f" {label} ", self))
+        box = QSpinBox(self)
+        box.setObjectName(name)
+        box.setRange(lo, hi)
+        box.setValue(value)
+        self.toolbar.addWidget(box)
+        return box
+
+    def _tint_button(self, name: str, field: str) -> QToolButton:
+        button = QToolButton(self)
+        button.setObjectName(name)
+        button.setToolTip("Tint of the " + ("earlier" if field == "before_tint" else "later") + " ghosts")
+
+        def paint() -> None:
+            r, g, b = getattr(self.view.onion, field)
+            button.setStyleSheet(f"background-color: rgb({r},{g},{b}); min-width: 16px;")
+
+        def choose() -> None:
+            r, g, b = getattr(self.view.onion, field)
+            color = QColorDialog.getColor(QColor(r, g, b), self, "Onion skin tint")
+            if color.isValid():
+                self._set_onion(**{field: (color.red(), color.green(), color.blue())})
+                paint()
+
+        button.clicked.connect(choose)
+        paint()
+        self.toolbar.addWidget(button)
+        return button
+
+    def _set_onion(self, **changes: Any) -> None:
+        from dataclasses import replace
+
+        self.view.onion = replace(self.view.onion, **changes)
+        self.view.viewport().update()
+
+    def _onion_changed(self) -> None:
+        self._set_onion(enabled=self.onion_box.isChecked(), before=self.before_box.value(),
+                        after=self.after_box.value(), step=self.step_box.value())
+
+
+# ---------------------------------------------------------------------- openers
+def open_characters(window: MainWindow, path: Path) -> None:
+    """Add the characters of an SVG file or folder (FormatError leaves the document as is)."""
+    command = _c2d().add_characters_command(window.doc, path)
+    window.ctx.push(command)
+    editor = getattr(window, "rig_editor", None)
+    if editor is not None:
+        editor.view.fit_view()
+        window.central_tabs.setCurrentWidget(editor)
+
+
+def install(window: MainWindow) -> None:
+    try:
+        _c2d()
+        _painter2d()
+    except ModuleNotFoundError:
+        return  # the 2D engine is not there yet
+    editor = RigEditor(window.ctx)
+    window.rig_editor = editor  # type: ignore[attr-defined]
+    window.add_central(editor, "2D Rig")
+    window.openers[".svg"] = open_characters
+    window.openers["/"] = open_characters
+    window.view_menu.addAction(editor.fit_action)
+    window.view_menu.addAction(editor.debug_action)
+
+
+__all__ = ["CharacterItem", "RigEditor", "RigEditorView", "install", "open_characters"]

@@ -1,0 +1,314 @@
+"""What the mouse does in the 2D rig editor, as plain functions and generators (no Qt).
+
+A drag is a generator (as in napari's mouse bindings): prime it with ``next(drag)``, then
+``drag.send(cursor)`` for each mouse move returns the command for that position. Every
+command of one drag carries the same gesture token, and :class:`Gesture` folds them into
+one command, so a drag is one undo step and Escape can take it back exactly.
+
+Points are world (scene) coordinates: SVG user units, y down.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Generator, Hashable, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import numpy.typing as npt
+
+from qtanimator.document.commands import Command, Macro
+from qtanimator.document.document import Document, channel_id
+
+FloatArray = npt.NDArray[np.float64]
+Drag = Generator["Command | None", Any, None]
+
+#: Hit-test tolerance in scene units for thin strokes.
+PICK_TOLERANCE = 2.0
+
+
+def _c2d() -> Any:
+    from qtanimator.document import character2d
+
+    return character2d
+
+
+# ----------------------------------------------------------------------- scene
+def character_ids(doc: Document) -> list[str]:
+    """The 2D characters of the document in draw order (later ones on top)."""
+    kind = _c2d().ASSET_KIND
+    return [aid for aid, a in doc.assets.items() if a.kind == kind and aid in doc.runtime]
+
+
+def pick(doc: Document, time: float, point: Sequence[float],
+         tolerance: float = PICK_TOLERANCE) -> tuple[str, int] | None:
+    """The topmost (character, joint index) under ``point``, or None."""
+    c2d = _c2d()
+    for aid in reversed(character_ids(doc)):
+        character = doc.runtime[aid]
+        pose = c2d.evaluate_pose(doc, aid, time)
+        j = character.hit_test(pose, np.asarray(point, dtype=np.float64), tolerance)
+        if j is not None:
+            return aid, int(j)
+    return None
+
+
+def rotation_delta(pivot: Sequence[float], press: Sequence[float], cursor: Sequence[float]) -> float:
+    """The joint angle (counter-clockwise on a y-down screen) carrying the press direction
+    onto the cursor direction about ``pivot`` — the reference's atan2(a×b, a·b)."""
+    ax, ay = cursor[0] - pivot[0], cursor[1] - pivot[1]
+    bx, by = press[0] - pivot[0], press[1] - pivot[1]
+    if (ax == 0 and ay == 0) or (bx == 0 and by == 0):
+        return 0.0
+    return math.atan2(ax * by - ay * bx, ax * bx + ay * by)
+
+
+# --------------------------------------------------------------------- gestures
+class Gesture:
+    """The commands of one drag folded into one: applied live, undone on abort."""
+
+    def __init__(self, doc: Document, token: Hashable, text: str = "Drag") -> None:
+        self.doc = doc
+        self.token = token
+        self.text = text
+        self.command: Command | None = None
+
+    @property
+    def active(self) -> bool:
+        return self.command is not None
+
+    def apply(self, command: Command | None) -> None:
+        """Do ``command`` on the document now and fold it into the gesture."""
+        if command is None:
+            return
+        command.do(self.doc)
+        if self.command is None:
+            self.command = command
+        elif not self.command.merge(command):
+            self.command = Macro(self.command.text, [self.command, command], gesture=self.token)
+
+    def abort(self) -> None:
+        """Undo everything the drag did (Escape)."""
+        if self.command is not None:
+            self.command.undo(self.doc)
+        self.command = None
+
+    def finish(self) -> Command | None:
+        """The one command to record (already done; doing it again is harmless)."""
+        command, self.command = self.command, None
+        return command
+
+
+def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float,
+                gesture: Hashable) -> Drag:
+    """Left-drag on a joint: rotate it about its pivot following the cursor."""
+    c2d = _c2d()
+    pose = c2d.evaluate_pose(doc, asset, time)
+    pivot = pose.pivots[joint].copy()
+    start = float(np.asarray(c2d.joint_angles(doc, asset, time))[joint])
+    cursor = yield None
+    while True:
+        angle = start + rotation_delta(pivot, press, cursor)
+        cursor = yield c2d.key_joint(doc, asset, joint, angle, time, gesture=gesture)
+
+
+def move_drag(doc: Document, asset: str, press: Sequence[float], time: float, gesture: Hashable) -> Drag:
+    """Left-drag on a root joint: move the character (a position key at ``time``)."""
+    c2d = _c2d()
+    start = np.asarray(c2d.evaluate_pose(doc, asset, time).translation, dtype=np.float64).copy()
+    p0 = np.asarray(press, dtype=np.float64)
+    cursor = yield None
+    while True:
+        xy = start + (np.asarray(cursor, dtype=np.float64) - p0)
+        cursor = yield c2d.move_character(doc, asset, (float(xy[0]), float(xy[1])), time, gesture=gesture)
+
+
+#: IK solver settings (document parameters, edited in the properties dock).
+IK_DEFAULTS: dict[str, Any] = {
+    "ik.solver": "dls",             # "dls" (damped least squares) or "handout" (gradient descent)
+    "ik.freeze_root": True,
+    "ik.max_iterations": 100,
+    "ik.damping": 1e-3,
+    "ik.handout_step": 1e-6,
+    "ik.handout_iterations": 10,
+    "ik.gradient_arrow_scale": 0.1,
+}
+
+
+def ik_setting(doc: Document, name: str) -> Any:
+    return doc.parameter(name, IK_DEFAULTS[name])
+
+
+def ik_command(doc: Document, asset: str, joint: int, local_point: Sequence[float] | FloatArray,
+               target: Sequence[float] | FloatArray, time: float, gesture: Hashable) -> Command:
+    """One IK update as a keying command, with the solver settings of the document.
+
+    The default settings go through ``character2d.ik_drag``; other settings solve here
+    with ``core.ik`` and key the keyframed joints that moved (an adapter: ``ik_drag`` takes
+    only joint limits).
+    """
+    c2d = _c2d()
+    solver = str(ik_setting(doc, "ik.solver"))
+    custom = {k: doc.parameters[k] for k in IK_DEFAULTS if k in doc.parameters
+              and doc.parameters[k] != IK_DEFAULTS[k] and k != "ik.gradient_arrow_scale"}
+    if not custom:
+        return c2d.ik_drag(doc, asset, joint, local_point, target, time, gesture=gesture)
+    from qtanimator.core.ik import gradient_descent_step, solve_ik
+    from qtanimator.document.commands import SetKeys
+
+    character = doc.runtime[asset]
+    before = np.asarray(c2d.joint_angles(doc, asset, time), dtype=np.float64)
+    translation = c2d.translation(doc, asset, time)
+    if solver == "handout":
+        after = gradient_descent_step(character, before, translation, joint, local_point, target,
+                                      step=float(ik_setting(doc, "ik.handout_step")),
+                                      iterations=int(ik_setting(doc, "ik.handout_iterations")))
+    else:
+        after = solve_ik(character, before, translation, joint, local_point, target,
+                         freeze_root=bool(ik_setting(doc, "ik.freeze_root")),
+                         max_iterations=int(ik_setting(doc, "ik.max_iterations")),
+                         damping=float(ik_setting(doc, "ik.damping")))
+    from qtanimator.core.channel import Key
+
+    keys = {c2d.angle_channel_id(asset, j.name): Key(float(time), float(after[k]))
+            for k, j in enumerate(character.joints)
+            if not j.is_dynamic and abs(after[k] - before[k]) > 1e-12}
+    return SetKeys(doc, keys, text="IK drag", gesture=gesture)
+
+
+def ik_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float,
+            gesture: Hashable) -> Drag:
+    """Right-drag: pull the picked point of ``joint`` towards the cursor with the IK solver."""
+    c2d = _c2d()
+    pose = c2d.evaluate_pose(doc, asset, time)
+    local = pose.to_local(joint, np.asarray(press, dtype=np.float64))
+    cursor = yield None
+    while True:
+        target = np.asarray(cursor, dtype=np.float64)
+        cursor = yield ik_command(doc, asset, joint, local, target, time, gesture)
+
+
+def ik_source(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> FloatArray:
+    """The rest-pose point of ``joint`` under ``press`` (kept for the debug dot)."""
+    pose = _c2d().evaluate_pose(doc, asset, time)
+    return np.asarray(pose.to_local(joint, np.asarray(press, dtype=np.float64)), dtype=np.float64)
+
+
+# --------------------------------------------------------------- debug overlays
+def gradient_arrows(character: Any, pose: Any, gradient: FloatArray,
+                    scale: float = 0.1) -> list[tuple[FloatArray, FloatArray]]:
+    """Arrows (start, end) at each joint's first child, perpendicular to joint → child,
+    of length ``scale · D`` (the reference's debug drawing)."""
+    arrows = []
+    for j, joint in enumerate(character.joints):
+        if not joint.children or gradient[j] == 0:
+            continue
+        start = pose.pivots[joint.children[0]]
+        e1 = start - pose.pivots[j]
+        n = float(np.hypot(*e1))
+        if n == 0:
+            continue
+        e1 = e1 / n
+        e2 = np.array([-e1[1], e1[0]])
+        arrows.append((start.copy(), start + e2 * scale * gradient[j]))
+    return arrows
+
+
+@dataclass(frozen=True)
+class PathKey:
+    """The character's root at one key of its position channels (per-second derivatives)."""
+
+    time: float
+    position: FloatArray
+    velocity: FloatArray
+    acceleration: FloatArray
+
+
+def _xy_channels(doc: Document, asset: str) -> tuple[Any, Any]:
+    return doc.channels.get(channel_id(asset, "", "x")), doc.channels.get(channel_id(asset, "", "y"))
+
+
+def _eval(channel: Any, t: Any, d: int = 0) -> Any:
+    if channel is None:
+        return np.zeros_like(np.asarray(t, dtype=np.float64))
+    return np.asarray(channel.evaluate(np.asarray(t, dtype=np.float64), d), dtype=np.float64)
+
+
+def character_path(doc: Document, asset: str, frames: Sequence[float] | FloatArray) -> FloatArray:
+    """Root pivot positions (N, 2) at ``frames`` (the debug spline)."""
+    character = doc.runtime[asset]
+    t = np.asarray(frames, dtype=np.float64) / doc.fps
+    cx, cy = _xy_channels(doc, asset)
+    pivot = character.joints[0].pivot
+    return np.stack([_eval(cx, t) + pivot[0], _eval(cy, t) + pivot[1]], axis=1)
+
+
+def path_keys(doc: Document, asset: str) -> list[PathKey]:
+    """Position, velocity and acceleration at each key time of the position channels."""
+    cx, cy = _xy_channels(doc, asset)
+    times = sorted({k.time for ch in (cx, cy) if ch is not None for k in ch.keys})
+    if not times:
+        return []
+    pivot = doc.runtime[asset].joints[0].pivot
+    t = np.asarray(times)
+    pos = np.stack([_eval(cx, t) + pivot[0], _eval(cy, t) + pivot[1]], axis=1)
+    vel = np.stack([_eval(cx, t, 1), _eval(cy, t, 1)], axis=1)
+    acc = np.stack([_eval(cx, t, 2), _eval(cy, t, 2)], axis=1)
+    return [PathKey(float(t[i]), pos[i], vel[i], acc[i]) for i in range(len(times))]
+
+
+def hud_lines(doc: Document, asset: str, joint: int | None, time: float) -> list[str]:
+    """The HUD text: the character's position / velocity / acceleration and the joint's
+    type with its angle (keyframed) or θ and ω (dynamic)."""
+    c2d = _c2d()
+    character = doc.runtime[asset]
+    cx, cy = _xy_channels(doc, asset)
+    pos = (float(_eval(cx, time)), float(_eval(cy, time)))
+    vel = (float(_eval(cx, time, 1)), float(_eval(cy, time, 1)))
+    acc = (float(_eval(cx, time, 2)), float(_eval(cy, time, 2)))
+    lines = [f"CHARACTER  {asset}",
+             f"position      ({pos[0]:8.2f}, {pos[1]:8.2f})",
+             f"velocity      ({vel[0]:8.2f}, {vel[1]:8.2f}) /s",
+             f"acceleration  ({acc[0]:8.2f}, {acc[1]:8.2f}) /s²"]
+    if joint is None:
+        return lines
+    j = character.joints[joint]
+    lines.append(f"JOINT  {j.name}")
+    if j.is_dynamic:
+        frame = int(round(doc.time_to_frame(time)))
+        theta_all, omega_all = c2d.simulation(doc).state(asset, frame)
+        theta, omega = float(theta_all[joint]), float(omega_all[joint])
+        lines += ["type          dynamic (pendulum)",
+                  f"θ             {math.degrees(theta):8.2f}°",
+                  f"ω             {math.degrees(omega):8.2f}°/s"]
+    else:
+        angle = float(np.asarray(c2d.joint_angles(doc, asset, time))[joint])
+        lines += ["type          keyframed", f"angle         {math.degrees(angle):8.2f}°"]
+    return lines
+
+
+# -------------------------------------------------------------------- onion skin
+@dataclass(frozen=True)
+class OnionSettings:
+    enabled: bool = False
+    before: int = 2
+    after: int = 2
+    step: int = 5
+    before_tint: tuple[int, int, int] = (220, 60, 60)
+    after_tint: tuple[int, int, int] = (60, 160, 60)
+    opacity: float = 0.35
+
+
+def onion_frames(frame: float, settings: OnionSettings, first: int, last: int) -> list[tuple[float, str, float]]:
+    """Ghost frames ``(frame, 'before' | 'after', opacity)``, farthest first, inside the
+    range; opacity fades with distance."""
+    if not settings.enabled or settings.step <= 0:
+        return []
+    ghosts: list[tuple[float, str, float]] = []
+    for side, count, sign in (("before", settings.before, -1), ("after", settings.after, 1)):
+        for i in range(count, 0, -1):
+            f = frame + sign * i * settings.step
+            if first <= f <= last:
+                ghosts.append((float(f), side, settings.opacity * (1.0 - (i - 1) / max(count, 1))))
+    return ghosts

@@ -1,0 +1,369 @@
+"""The timeline: frame ruler, key ticks, the current-frame cursor, and the play controls.
+
+Keys follow the reference animator: Space play / pause, ←/→ step (wrapping), Shift+←/→
+±10 frames, Alt+←/→ previous / next key, Home or ↑ start, End or ↓ end, ``[`` / ``]``
+shorten / lengthen the range by 100 frames (an undoable parameter change).
+"""
+
+from __future__ import annotations
+
+import bisect
+import math
+from typing import TYPE_CHECKING
+
+from PySide6.QtCore import QPointF, QRectF, QSize, Qt
+from PySide6.QtGui import QAction, QColor, QFont, QKeySequence, QMouseEvent, QPainter, QPaintEvent, QPen
+from PySide6.QtWidgets import (
+    QHBoxLayout,
+    QLabel,
+    QSizePolicy,
+    QSpinBox,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from qtanimator.document.commands import Macro, SetParameter
+from qtanimator.document.document import ChangeEvent, split_channel_id
+from qtanimator.ui.context import EditorContext
+from qtanimator.ui.playback import Playback, playback_frame
+
+if TYPE_CHECKING:
+    from qtanimator.ui.main_window import MainWindow
+
+__all__ = ["Playback", "TimelineWidget", "TimelinePanel", "install", "key_frames", "playback_frame"]
+
+RANGE_STEP = 100
+MARGIN = 10
+
+
+def key_frames(ctx: EditorContext, asset: str | None = None) -> list[float]:
+    """Sorted frames that hold a key in any channel (of ``asset`` when given)."""
+    fps = ctx.doc.fps
+    frames: set[float] = set()
+    for cid, ch in ctx.doc.channels.items():
+        if asset is not None and split_channel_id(cid)[0] != asset:
+            continue
+        for k in ch.keys:
+            frames.add(round(k.time * fps, 6))
+    return sorted(frames)
+
+
+class TimelineWidget(QWidget):
+    """The ruler with key ticks and cursor; press or drag to scrub."""
+
+    def __init__(self, ctx: EditorContext, playback: Playback, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("timeline")
+        self.ctx = ctx
+        self.playback = playback
+        self.setMinimumHeight(48)
+        self.setSizePolicy(QSizePolicy.Policy.Expanding, QSizePolicy.Policy.Expanding)
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        self.setMouseTracking(False)
+        self._keys: list[float] | None = None
+        self._selected_keys: list[float] | None = None
+        ctx.frameChanged.connect(lambda _f: self.update())
+        ctx.documentChanged.connect(self._on_document_changed)
+        ctx.documentReset.connect(self._invalidate)
+        ctx.selectionChanged.connect(lambda _a, _j: self._invalidate())
+
+    def sizeHint(self) -> QSize:
+        return QSize(800, 52)
+
+    # --------------------------------------------------------------- keys
+    def _on_document_changed(self, event: ChangeEvent) -> None:
+        if event.kind in ("channel", "parameter", "asset"):
+            self._invalidate()
+
+    def _invalidate(self) -> None:
+        self._keys = None
+        self._selected_keys = None
+        self.update()
+
+    def keys(self) -> list[float]:
+        if self._keys is None:
+            self._keys = key_frames(self.ctx)
+        return self._keys
+
+    def selected_keys(self) -> list[float]:
+        if self._selected_keys is None:
+            asset = self.ctx.selection[0]
+            self._selected_keys = key_frames(self.ctx, asset) if asset else []
+        return self._selected_keys
+
+    # ---------------------------------------------------------- geometry
+    def _span(self) -> tuple[int, int]:
+        first, last = self.ctx.doc.frame_range
+        return first, max(last, first + 1)
+
+    def frame_to_x(self, frame: float) -> float:
+        first, last = self._span()
+        width = max(self.width() - 2 * MARGIN, 1)
+        return MARGIN + (frame - first) / (last - first) * width
+
+    def x_to_frame(self, x: float) -> float:
+        first, last = self._span()
+        width = max(self.width() - 2 * MARGIN, 1)
+        frame = first + (x - MARGIN) / width * (last - first)
+        return float(min(max(round(frame), first), last))
+
+    # -------------------------------------------------------------- mouse
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        if event.button() == Qt.MouseButton.LeftButton:
+            self.playback.pause()
+            self.ctx.set_frame(self.x_to_frame(event.position().x()))
+            event.accept()
+        else:
+            super().mousePressEvent(event)
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if event.buttons() & Qt.MouseButton.LeftButton:
+            self.ctx.set_frame(self.x_to_frame(event.position().x()))
+            event.accept()
+
+    # ------------------------------------------------------------ drawing
+    def paintEvent(self, _event: QPaintEvent) -> None:
+        p = QPainter(self)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing, False)
+        w, h = self.width(), self.height()
+        p.fillRect(self.rect(), QColor(48, 48, 52))
+        bar = QRectF(MARGIN, 18, w - 2 * MARGIN, h - 24)
+        p.fillRect(bar, QColor(235, 235, 240, 204))
+
+        first, last = self._span()
+        px_per_frame = bar.width() / (last - first)
+        step = 1
+        for candidate in (1, 2, 5, 10, 20, 25, 50, 100, 200, 250, 500, 1000, 2000, 5000):
+            step = candidate
+            if candidate * px_per_frame >= 48:
+                break
+        minor = max(step // 5, 1) if step >= 5 else step
+        font = QFont(self.font())
+        font.setPointSizeF(max(font.pointSizeF() * 0.8, 6.0))
+        p.setFont(font)
+        p.setPen(QPen(QColor(90, 90, 96), 1))
+        f = math.ceil(first / minor) * minor
+        while f <= last:
+            x = self.frame_to_x(f)
+            major = f % step == 0
+            p.drawLine(QPointF(x, bar.top()), QPointF(x, bar.top() + (8 if major else 4)))
+            if major:
+                p.setPen(QColor(220, 220, 220))
+                p.drawText(QPointF(x + 2, 13), str(f))
+                p.setPen(QPen(QColor(90, 90, 96), 1))
+            f += minor
+
+        # Key ticks: every key in red, the selected character's keys taller.
+        p.setPen(QPen(QColor(200, 30, 30), 1))
+        for kf in self.keys():
+            if first <= kf <= last:
+                x = self.frame_to_x(kf)
+                p.drawLine(QPointF(x, bar.top() + 10), QPointF(x, bar.bottom()))
+        p.setPen(QPen(QColor(255, 140, 0), 2))
+        for kf in self.selected_keys():
+            if first <= kf <= last:
+                x = self.frame_to_x(kf)
+                p.drawLine(QPointF(x, bar.top() + 4), QPointF(x, bar.bottom()))
+
+        x = self.frame_to_x(self.ctx.frame)
+        p.setPen(QPen(QColor(230, 0, 0), 2))
+        p.drawLine(QPointF(x, bar.top() - 2), QPointF(x, bar.bottom()))
+        p.end()
+
+
+class TimelinePanel(QWidget):
+    """Buttons, the frame readout and the ruler, as one dock widget."""
+
+    def __init__(self, ctx: EditorContext, playback: Playback, actions: dict[str, QAction],
+                 parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("timelinePanel")
+        self.ctx = ctx
+        self.timeline = TimelineWidget(ctx, playback, self)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(4, 2, 4, 2)
+        layout.setSpacing(2)
+        row = QHBoxLayout()
+        row.setSpacing(2)
+        for name in ("actionRewind", "actionStepBack", "actionPlay", "actionStop", "actionStepForward",
+                     "actionLoop"):
+            button = QToolButton(self)
+            button.setDefaultAction(actions[name])
+            button.setObjectName(name.replace("action", "button"))
+            button.setAutoRaise(True)
+            row.addWidget(button)
+        row.addSpacing(12)
+        row.addWidget(QLabel("Frame", self))
+        self.frame_box = QSpinBox(self)
+        self.frame_box.setObjectName("frameSpinBox")
+        self.frame_box.setKeyboardTracking(False)
+        row.addWidget(self.frame_box)
+        self.range_label = QLabel(self)
+        self.range_label.setObjectName("frameRangeLabel")
+        row.addWidget(self.range_label)
+        self.fps_label = QLabel(self)
+        self.fps_label.setObjectName("playbackRateLabel")
+        row.addStretch(1)
+        row.addWidget(self.fps_label)
+        layout.addLayout(row)
+        layout.addWidget(self.timeline, 1)
+        self.frame_box.valueChanged.connect(lambda v: ctx.set_frame(float(v)))
+        ctx.frameChanged.connect(self._sync)
+        ctx.documentChanged.connect(lambda _e: self._sync())
+        ctx.documentReset.connect(self._sync)
+        self._sync()
+
+    def _sync(self, *_args: object) -> None:
+        first, last = self.ctx.doc.frame_range
+        self.frame_box.blockSignals(True)
+        self.frame_box.setRange(first, max(last, first))
+        self.frame_box.setValue(int(round(self.ctx.frame)))
+        self.frame_box.blockSignals(False)
+        self.range_label.setText(f"{first} – {last} @ {self.ctx.doc.fps:g} fps")
+
+
+class TimelineController:
+    """The frame-stepping and range logic behind the timeline's keys and buttons."""
+
+    def __init__(self, ctx: EditorContext, playback: Playback) -> None:
+        self.ctx = ctx
+        self.playback = playback
+
+    def _go(self, frame: float) -> None:
+        self.playback.pause()
+        self.ctx.set_frame(frame)
+
+    def step(self, delta: int, wrap: bool = True) -> None:
+        first, last = self.ctx.doc.frame_range
+        frame = int(round(self.ctx.frame)) + delta
+        if wrap:
+            span = last - first + 1
+            frame = first + (frame - first) % span if span > 0 else first
+        else:
+            frame = min(max(frame, first), last)
+        self._go(float(frame))
+
+    def to_start(self) -> None:
+        self._go(float(self.ctx.doc.frame_range[0]))
+
+    def to_end(self) -> None:
+        self._go(float(self.ctx.doc.frame_range[1]))
+
+    def next_key(self) -> None:
+        keys = key_frames(self.ctx)
+        i = bisect.bisect_right(keys, self.ctx.frame + 1e-6)
+        if i < len(keys):
+            self._go(keys[i])
+
+    def previous_key(self) -> None:
+        keys = key_frames(self.ctx)
+        i = bisect.bisect_left(keys, self.ctx.frame - 1e-6)
+        if i > 0:
+            self._go(keys[i - 1])
+
+    def change_length(self, delta: int) -> None:
+        doc = self.ctx.doc
+        first, last = doc.frame_range
+        new_last = last + delta
+        if new_last - first < RANGE_STEP and delta < 0:
+            return  # the reference only shortens a range longer than 100 frames
+        self.ctx.push(Macro("Timeline Length", [SetParameter(doc, "frame_end", new_last)]))
+        if self.ctx.frame > new_last:
+            self.ctx.set_frame(float(new_last))
+
+
+def _make_actions(window: MainWindow, playback: Playback, control: TimelineController) -> dict[str, QAction]:
+    style = window.style()
+    from PySide6.QtWidgets import QStyle
+
+    def action(name: str, text: str, slot: object, keys: list[str], icon: QStyle.StandardPixmap | None = None,
+               context: Qt.ShortcutContext = Qt.ShortcutContext.WidgetWithChildrenShortcut) -> QAction:
+        a = QAction(text, window)
+        a.setObjectName(name)
+        if icon is not None:
+            a.setIcon(style.standardIcon(icon))
+        if keys:
+            a.setShortcuts([QKeySequence(k) for k in keys])
+            a.setShortcutContext(context)
+            a.setAutoRepeat(True)
+        a.triggered.connect(lambda _checked=False: slot())  # type: ignore[operator]
+        return a
+
+    sp = QStyle.StandardPixmap
+    actions = {
+        "actionPlay": action("actionPlay", "Play / Pause", playback.toggle, ["Space"], sp.SP_MediaPlay,
+                             Qt.ShortcutContext.WindowShortcut),
+        "actionStop": action("actionStop", "Stop", playback.stop, [], sp.SP_MediaStop),
+        "actionRewind": action("actionRewind", "Rewind", control.to_start, ["Home", "Up"], sp.SP_MediaSkipBackward),
+        "actionEnd": action("actionEnd", "Go to End", control.to_end, ["End", "Down"], sp.SP_MediaSkipForward),
+        "actionStepBack": action("actionStepBack", "Step Back", lambda: control.step(-1), ["Left"],
+                                 sp.SP_MediaSeekBackward),
+        "actionStepForward": action("actionStepForward", "Step Forward", lambda: control.step(1), ["Right"],
+                                    sp.SP_MediaSeekForward),
+        "actionStepBack10": action("actionStepBack10", "Back 10 Frames", lambda: control.step(-10, wrap=False),
+                                   ["Shift+Left"]),
+        "actionStepForward10": action("actionStepForward10", "Forward 10 Frames",
+                                      lambda: control.step(10, wrap=False), ["Shift+Right"]),
+        "actionPreviousKey": action("actionPreviousKey", "Previous Key", control.previous_key, ["Alt+Left"]),
+        "actionNextKey": action("actionNextKey", "Next Key", control.next_key, ["Alt+Right"]),
+        "actionShorterRange": action("actionShorterRange", "Shorten Range by 100", lambda: control.change_length(
+            -RANGE_STEP), ["["]),
+        "actionLongerRange": action("actionLongerRange", "Lengthen Range by 100", lambda: control.change_length(
+            RANGE_STEP), ["]"]),
+        "actionLoop": action("actionLoop", "Loop", lambda: None, [], sp.SP_BrowserReload),
+    }
+    actions["actionPlay"].setAutoRepeat(False)
+    loop = actions["actionLoop"]
+    loop.setCheckable(True)
+    loop.setChecked(playback.loop)
+    loop.toggled.connect(playback.set_loop)
+    play = actions["actionPlay"]
+
+    def on_playing(playing: bool) -> None:
+        play.setIcon(style.standardIcon(sp.SP_MediaPause if playing else sp.SP_MediaPlay))
+        play.setText("Pause" if playing else "Play")
+
+    window.ctx.playingChanged.connect(on_playing)
+    return actions
+
+
+#: Widgets (by object name) that get the timeline's keys when they have the focus.
+KEY_TARGETS = ("rigEditorView", "viewport3d", "curvePlot", "jointTreeDock")
+
+
+def add_timeline_keys(window: MainWindow, widget: QWidget) -> None:
+    """Give ``widget`` the timeline's keys (arrows, Home/End, [ ]) while it has the focus."""
+    actions = getattr(window, "timeline_actions", None)
+    if actions:
+        widget.addActions(list(actions.values()))
+
+
+def install(window: MainWindow) -> None:
+    ctx = window.ctx
+    playback = Playback(ctx, window)
+    control = TimelineController(ctx, playback)
+    actions = _make_actions(window, playback, control)
+    panel = TimelinePanel(ctx, playback, actions)
+    panel.addActions(list(actions.values()))
+    window.playback = playback  # type: ignore[attr-defined]
+    window.timeline_control = control  # type: ignore[attr-defined]
+    window.timeline_actions = actions  # type: ignore[attr-defined]
+    window.timeline_dock = window.add_dock(  # type: ignore[attr-defined]
+        "timelineDock", "Timeline", panel, Qt.DockWidgetArea.BottomDockWidgetArea)
+    menu = window.view_menu.addMenu("&Playback")
+    menu.setObjectName("menuPlayback")
+    for a in actions.values():
+        menu.addAction(a)
+    window.addAction(actions["actionPlay"])
+    for name in KEY_TARGETS:
+        target = window.findChild(QWidget, name)
+        if target is not None:
+            add_timeline_keys(window, target)
+
+    def update_rate(_frame: float, _skipped: int) -> None:
+        panel.fps_label.setText(f"{playback.measured_fps():.0f} fps, {playback.dropped_frames} dropped")
+
+    playback.ticked.connect(update_rate)
+    # Stop playing when the document is replaced.
+    ctx.documentReset.connect(playback.pause)

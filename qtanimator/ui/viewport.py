@@ -1,0 +1,748 @@
+"""The 3D viewport: skinned characters, skeletons and cloth under two coloured lights.
+
+``install(window)`` adds a central tab "3D" holding a toolbar, the GL view (a
+QOpenGLWidget named ``viewport3d``) and clip playback controls.
+
+Mouse: left click picks a joint (``ctx.select``); left drag orbits (on a live cloth it grabs
+the cloth, on a light's sphere it moves the light); middle drag or Shift+left pans; wheel or
+Ctrl+left zooms; right drag on a joint solves IK on its chain (one undo step, keyed at the
+current frame); right drag elsewhere zooms. Keys: F frames the selection (or everything),
+W/A/S/D/Q/E move a live cloth's pins, Z/C rotate them, P pauses the live cloth, R resets it,
+Escape cancels an IK drag.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+import time as _time
+from typing import Any
+
+import numpy as np
+from PySide6.QtCore import QElapsedTimer, QPointF, Qt, QTimer, Signal
+from PySide6.QtGui import QKeyEvent, QMouseEvent, QWheelEvent
+from PySide6.QtOpenGLWidgets import QOpenGLWidget
+from PySide6.QtWidgets import (
+    QCheckBox,
+    QComboBox,
+    QDoubleSpinBox,
+    QHBoxLayout,
+    QLabel,
+    QProgressBar,
+    QSpinBox,
+    QToolButton,
+    QVBoxLayout,
+    QWidget,
+)
+
+from qtanimator.render.gl import surface_format
+from qtanimator.render.gl.camera import OrbitCamera
+from qtanimator.render.gl.lights import LIGHT_NAMES, ambient_of, lights_of
+from qtanimator.render.gl.picking import pick_joint, ray_sphere
+from qtanimator.render.gl.renderer import (
+    WEIGHTS_ALL,
+    WEIGHTS_OFF,
+    CharacterDraw,
+    ClothDraw,
+    SceneItem,
+    SceneRenderer,
+    ViewOptions,
+    grid_scale_for,
+)
+from qtanimator.render.scene3d import CLOTH_KIND, scene_bounds, scene_items
+from qtanimator.ui.context import EditorContext
+
+_gestures = itertools.count(1)
+
+#: Cloth pin moves per key press: metres and radians.
+PIN_STEP = 0.05
+PIN_TURN = math.radians(5.0)
+PIN_KEYS = {
+    Qt.Key.Key_W: (0.0, 0.0, -PIN_STEP), Qt.Key.Key_S: (0.0, 0.0, PIN_STEP),
+    Qt.Key.Key_A: (-PIN_STEP, 0.0, 0.0), Qt.Key.Key_D: (PIN_STEP, 0.0, 0.0),
+    Qt.Key.Key_Q: (0.0, PIN_STEP, 0.0), Qt.Key.Key_E: (0.0, -PIN_STEP, 0.0),
+}
+PIN_TURNS = {Qt.Key.Key_Z: PIN_TURN, Qt.Key.Key_C: -PIN_TURN}
+#: The live cloth's fixed simulation step (seconds).
+SIM_DT = 1.0 / 60.0
+
+
+class LiveCloths:
+    """Interactive cloth simulations, one per cloth asset, stepped by the wall clock.
+
+    While ``enabled`` the viewport shows these instead of the document's cached simulation,
+    so pins can be moved with the keyboard and the cloth grabbed with the mouse.
+    """
+
+    def __init__(self) -> None:
+        self.enabled = False
+        self.paused = False
+        self.cloths: dict[str, Any] = {}
+        self.errors: dict[str, str] = {}
+
+    def sync(self, doc: Any) -> None:
+        """Create live cloths for new cloth assets, drop removed ones, follow parameter edits."""
+        ids = [a for a, asset in doc.assets.items() if asset.kind == CLOTH_KIND]
+        for key in [k for k in self.cloths if k not in ids]:
+            del self.cloths[key]
+        for asset_id in ids:
+            params = cloth_params(doc, asset_id)
+            if params is None:
+                continue
+            cloth = self.cloths.get(asset_id)
+            if cloth is None:
+                from qtanimator.core.cloth import Cloth
+
+                self.cloths[asset_id] = Cloth(params)
+            elif cloth.params != params:
+                cloth.set_params(params)
+
+    def step(self, dt: float) -> None:
+        if not self.enabled or self.paused:
+            return
+        for asset_id, cloth in self.cloths.items():
+            if cloth.error is not None:
+                continue
+            try:
+                cloth.step(dt)
+            except RuntimeError as exc:  # ClothBlowUp: the cloth stays stopped until reset
+                self.errors[asset_id] = str(exc)
+
+    def reset(self) -> None:
+        for cloth in self.cloths.values():
+            cloth.reset()
+        self.errors.clear()
+
+    def move_pins(self, translation: Any = (0.0, 0.0, 0.0), rotation: Any = None) -> None:
+        for cloth in self.cloths.values():
+            cloth.move_pins(translation, rotation)
+
+
+def cloth_params(doc: Any, asset_id: str) -> Any:
+    """The ClothParams of a cloth asset (from its properties), or None."""
+    try:
+        from qtanimator.core.cloth import ClothParams
+    except ImportError:
+        return None
+    try:
+        from qtanimator.document import cloth as cloth_doc
+
+        getter = getattr(cloth_doc, "cloth_params", None)
+        if getter is not None:
+            return getter(doc, asset_id)
+    except ImportError:
+        pass
+    props = doc.assets[asset_id].properties
+    data = props.get("params", props)
+    try:
+        return ClothParams.from_dict(data)
+    except (TypeError, ValueError):
+        return ClothParams()
+
+
+class Viewport3D(QOpenGLWidget):
+    """The GL view of the 3D scene (object name ``viewport3d``)."""
+
+    #: CPU milliseconds the last paintGL took (scene build + GL calls).
+    frameRendered = Signal(float)
+    #: The interactive cloth simulation was switched on or off.
+    liveClothChanged = Signal(bool)
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("viewport3d")
+        self.setFormat(surface_format())
+        self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
+        self.setMinimumSize(160, 120)
+        self.ctx = ctx
+        self.camera = OrbitCamera()
+        self.options = ViewOptions()
+        self.renderer = SceneRenderer()
+        self.live = LiveCloths()
+        self.ik_chain_length = 3
+        self.last_error = ""
+        self.last_frame_ms = 0.0
+        self.gl_info = ""
+        self._items: list[SceneItem] = []
+        self._framed_once = False
+        self._drag: dict[str, Any] | None = None
+        self._press_pos = QPointF()
+        ctx.frameChanged.connect(lambda _f: self.update())
+        ctx.selectionChanged.connect(lambda _a, _j: self.update())
+        ctx.documentChanged.connect(self._on_document_changed)
+        ctx.documentReset.connect(self._on_document_reset)
+        self._sim_acc = 0.0
+        self._sim_clock = QElapsedTimer()
+        self._sim_timer = QTimer(self)
+        self._sim_timer.setInterval(16)
+        self._sim_timer.timeout.connect(self._tick_cloth)
+        self.live.sync(ctx.doc)
+
+    # ------------------------------------------------------------ document
+    def _on_document_changed(self, event: Any) -> None:
+        if event.kind in ("asset", "parameter"):
+            self.live.sync(self.ctx.doc)
+        self.update()
+
+    def _on_document_reset(self) -> None:
+        self.live.cloths.clear()
+        self.live.sync(self.ctx.doc)
+        self._framed_once = False
+        self.update()
+
+    def set_live_cloth(self, enabled: bool) -> None:
+        changed = enabled != self.live.enabled
+        self.live.enabled = enabled
+        self.live.sync(self.ctx.doc)
+        if enabled:
+            self._sim_clock.start()
+            self._sim_timer.start()
+        else:
+            self._sim_timer.stop()
+        if changed:
+            self.liveClothChanged.emit(enabled)
+        self.update()
+
+    def _tick_cloth(self) -> None:
+        """Step the live cloths at a fixed 60 Hz, independent of the timer's rate."""
+        self._sim_acc = min(self._sim_acc + self._sim_clock.restart() / 1000.0, 3 * SIM_DT)
+        stepped = False
+        while self._sim_acc >= SIM_DT:
+            self.live.step(SIM_DT)
+            self._sim_acc -= SIM_DT
+            stepped = True
+        if stepped:
+            self.update()
+
+    # ----------------------------------------------------------------- GL
+    def initializeGL(self) -> None:
+        from OpenGL import GL
+
+        version = GL.glGetString(GL.GL_VERSION)
+        renderer = GL.glGetString(GL.GL_RENDERER)
+        self.gl_info = f"{version.decode() if version else '?'} / {renderer.decode() if renderer else '?'}"
+        self.renderer.initialize()
+        self.context().aboutToBeDestroyed.connect(self._release_gl)
+
+    def _release_gl(self) -> None:
+        self.makeCurrent()
+        self.renderer.release()
+        self.doneCurrent()
+
+    def build_items(self) -> list[SceneItem]:
+        """What to draw now (and pick against)."""
+        override = self.live.cloths if self.live.enabled else None
+        errors: list[str] = []   # an asset that fails is left out; the others still draw
+        items = scene_items(self.ctx.doc, self.ctx.time, self.ctx.selection, override, errors)
+        self.last_error = "; ".join(errors)
+        return items
+
+    def paintGL(self) -> None:
+        start = _time.perf_counter()
+        self._items = self.build_items()
+        if not self._framed_once and self._items:
+            self.frame_all()
+            self._framed_once = True
+        ratio = self.devicePixelRatioF()
+        w, h = max(1, int(self.width() * ratio)), max(1, int(self.height() * ratio))
+        doc = self.ctx.doc
+        self.options.light_gizmo_size = self.gizmo_size()
+        self.renderer.render(self._items, self.camera, w, h, lights_of(doc), ambient_of(doc), self.options)
+        self.last_frame_ms = (_time.perf_counter() - start) * 1000.0
+        self.frameRendered.emit(self.last_frame_ms)
+
+    def render_image(self) -> np.ndarray:
+        """The current picture as an H×W×4 RGBA uint8 array (renders a frame)."""
+        from PySide6.QtGui import QImage
+
+        from qtanimator.render.render3d import qimage_to_array
+
+        return qimage_to_array(self.grabFramebuffer().convertToFormat(QImage.Format.Format_RGBA8888))
+
+    # ------------------------------------------------------------- camera
+    def frame_all(self) -> None:
+        items = self._items or self.build_items()
+        bounds = scene_bounds(items)
+        if bounds is not None:
+            self.camera.frame(*bounds)
+            self.options.grid_scale = grid_scale_for(*bounds)
+        self.update()
+
+    def frame_selection(self) -> None:
+        """Frame the selected joint's character (or everything)."""
+        asset, joint = self.ctx.selection
+        items = self._items or self.build_items()
+        chosen = [i for i in items if getattr(i, "asset_id", None) == asset] if asset else []
+        bounds = scene_bounds(chosen or items)
+        if bounds is not None:
+            self.camera.frame(*bounds)
+            if joint:
+                for item in chosen:
+                    if isinstance(item, CharacterDraw) and item.selected is not None:
+                        self.camera.target = item.world[item.selected, :3, 3].copy()
+        self.update()
+
+    def ray_at(self, pos: QPointF) -> tuple[np.ndarray, np.ndarray]:
+        return self.camera.ray(pos.x(), pos.y(), max(self.width(), 1), max(self.height(), 1))
+
+    def pick(self, pos: QPointF) -> tuple[str, int, float] | None:
+        """The joint under a widget position: (asset id, joint index, distance)."""
+        items = self.build_items()
+        if self.options.show_skin:
+            # over a skin the skeleton is drawn as spheres and bones: pick those
+            items = [dataclasses.replace(i, boxmin=None, boxmax=None)
+                     if isinstance(i, CharacterDraw) and i.skin is not None else i for i in items]
+        origin, direction = self.ray_at(pos)
+        return pick_joint(items, origin, direction)
+
+    def gizmo_size(self) -> float:
+        return 0.015 * self.camera.distance
+
+    def pick_light(self, pos: QPointF) -> str | None:
+        """The light whose gizmo is under a widget position ("light1" / "light2")."""
+        if not self.options.show_lights:
+            return None
+        origin, direction = self.ray_at(pos)
+        best = None
+        for name, light in zip(LIGHT_NAMES, lights_of(self.ctx.doc)):
+            t = ray_sphere(origin, direction, light.position, 1.5 * self.gizmo_size())
+            if t is not None and (best is None or t < best[1]):
+                best = (name, t)
+        return None if best is None else best[0]
+
+    def _joint_key(self, asset_id: str, index: int) -> str:
+        skel = getattr(self.ctx.doc.runtime.get(asset_id), "skeleton", None)
+        if skel is None:
+            return str(index)
+        return str(skel.joint_keys()[index])
+
+    # -------------------------------------------------------------- mouse
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        pos = event.position()
+        self._press_pos = QPointF(pos)
+        button, mods = event.button(), event.modifiers()
+        mode = "orbit"
+        if button == Qt.MouseButton.MiddleButton or (
+                button == Qt.MouseButton.LeftButton and mods & Qt.KeyboardModifier.ShiftModifier):
+            mode = "pan"
+        elif button == Qt.MouseButton.LeftButton and mods & Qt.KeyboardModifier.ControlModifier:
+            mode = "zoom"
+        elif button == Qt.MouseButton.LeftButton and not (mods & Qt.KeyboardModifier.AltModifier):
+            light = self.pick_light(pos)
+            if light is not None:
+                mode = "light"
+                self._light_drag = (light, ("light-drag", next(_gestures)))
+            elif self._start_grab(pos):
+                mode = "grab"
+            else:
+                mode = "click-orbit"
+        elif button == Qt.MouseButton.RightButton:
+            mode = "ik" if self._start_ik(pos) else "zoom"
+        self._drag = {"mode": mode, "last": QPointF(pos), "moved": False, **(self._drag or {})} \
+            if mode == "ik" else {"mode": mode, "last": QPointF(pos), "moved": False}
+        event.accept()
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if self._drag is None:
+            return
+        pos = event.position()
+        last: QPointF = self._drag["last"]
+        dx, dy = pos.x() - last.x(), pos.y() - last.y()
+        if (pos - self._press_pos).manhattanLength() > 3:
+            self._drag["moved"] = True
+        self._drag["last"] = QPointF(pos)
+        mode = self._drag["mode"]
+        if mode in ("orbit", "click-orbit"):
+            if self._drag["moved"]:
+                self.camera.orbit(-dx * 0.4, dy * 0.4)
+        elif mode == "pan":
+            self.camera.pan(dx, dy, self.height())
+        elif mode == "zoom":
+            self.camera.zoom(math.exp(dy * 0.01))
+        elif mode == "grab":
+            self._drag_grab(pos)
+        elif mode == "light":
+            self._drag_light(pos)
+        elif mode == "ik":
+            self._drag_ik(pos)
+        self.update()
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        drag, self._drag = self._drag, None
+        if drag is None:
+            return
+        if drag["mode"] == "click-orbit" and not drag["moved"]:
+            hit = self.pick(event.position())
+            if hit is None:
+                self.ctx.select("", "")
+            else:
+                self.ctx.select(hit[0], self._joint_key(hit[0], hit[1]))
+        elif drag["mode"] == "grab":
+            for cloth in self.live.cloths.values():
+                cloth.release()
+        self.update()
+
+    def wheelEvent(self, event: QWheelEvent) -> None:
+        steps = event.angleDelta().y() / 120.0
+        self.camera.zoom(0.88 ** steps)
+        self.update()
+
+    # ---------------------------------------------------------- light drag
+    def _drag_light(self, pos: QPointF) -> None:
+        """Move the dragged light in the plane through it facing the camera (one undo step)."""
+        from qtanimator.document.commands import SetParameter
+
+        name, gesture = self._light_drag
+        anchor = next(l.position for n, l in zip(LIGHT_NAMES, lights_of(self.ctx.doc)) if n == name)
+        target = self._on_view_plane(pos, anchor)
+        if target is None:
+            return
+        value = [round(float(v), 4) for v in target]
+        self.ctx.push(SetParameter(self.ctx.doc, f"{name}.position", value, text=f"Move {name}", gesture=gesture))
+
+    # ---------------------------------------------------------- cloth grab
+    def _start_grab(self, pos: QPointF) -> bool:
+        if not self.live.enabled:
+            return False
+        origin, direction = self.ray_at(pos)
+        for asset_id, cloth in self.live.cloths.items():
+            scale = max(cloth.params.width, cloth.params.height) / max(cloth.params.cols, cloth.params.rows)
+            if cloth.grab(origin, direction, max_distance=2.5 * scale) is not None:
+                p = cloth.positions[cloth.grabbed]
+                self._grab = (asset_id, p.copy(), self.camera.eye())
+                return True
+        return False
+
+    def _drag_grab(self, pos: QPointF) -> None:
+        asset_id, anchor, _eye = self._grab
+        target = self._on_view_plane(pos, anchor)
+        cloth = self.live.cloths.get(asset_id)
+        if cloth is not None and target is not None:
+            cloth.drag_grabbed(target)
+
+    def _on_view_plane(self, pos: QPointF, anchor: np.ndarray) -> np.ndarray | None:
+        """Where the mouse ray meets the plane through ``anchor`` facing the camera."""
+        origin, direction = self.ray_at(pos)
+        normal = self.camera.eye() - np.asarray(self.camera.target, dtype=float)
+        normal /= np.linalg.norm(normal)
+        den = float(direction @ normal)
+        if abs(den) < 1e-9:
+            return None
+        t = float((anchor - origin) @ normal) / den
+        return origin + t * direction
+
+    # ------------------------------------------------------------------ IK
+    def _start_ik(self, pos: QPointF) -> bool:
+        hit = self.pick(pos)
+        if hit is None:
+            return False
+        asset_id, joint, _t = hit
+        runtime = self.ctx.doc.runtime.get(asset_id)
+        skel = getattr(runtime, "skeleton", None)
+        if skel is None:
+            return False
+        self.ctx.select(asset_id, self._joint_key(asset_id, joint))
+        world = self._pose(asset_id).world_matrices()
+        self._drag = {"asset": asset_id, "joint": joint, "anchor": world[joint, :3, 3].copy(),
+                      "gesture": ("ik3d", next(_gestures)), "pushed": 0}
+        return True
+
+    def _pose(self, asset_id: str) -> Any:
+        from qtanimator.document import character3d
+
+        return character3d.pose_skeleton(self.ctx.doc, asset_id, self.ctx.time)
+
+    def _drag_ik(self, pos: QPointF) -> None:
+        from qtanimator.core.ik3d import solve_ik
+        from qtanimator.document import character3d
+
+        assert self._drag is not None
+        target = self._on_view_plane(pos, self._drag["anchor"])
+        if target is None:
+            return
+        asset_id, joint = self._drag["asset"], self._drag["joint"]
+        skel = self._pose(asset_id)
+        result = solve_ik(skel, joint, target, chain_length=self.ik_chain_length)
+        if not result.values:
+            return
+        values = {(j, axis): v for (j, axis), v in result.by_axis_name().items()}
+        cmd = character3d.set_dofs_command(self.ctx.doc, asset_id, values, self.ctx.time,
+                                           gesture=self._drag["gesture"])
+        self.ctx.push(cmd)
+        self._drag["pushed"] += 1
+
+    # ----------------------------------------------------------------- keys
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        key = event.key()
+        if key == Qt.Key.Key_F:
+            self.frame_selection()
+        elif key in PIN_KEYS or key in PIN_TURNS:
+            if not self.live.enabled:
+                self.set_live_cloth(True)
+            if key in PIN_KEYS:
+                self.live.move_pins(PIN_KEYS[key])
+            else:
+                self.live.move_pins((0.0, 0.0, 0.0), (0.0, PIN_TURNS[key], 0.0))
+            self.update()
+        elif key == Qt.Key.Key_P:
+            self.live.paused = not self.live.paused
+        elif key == Qt.Key.Key_R:
+            self.live.reset()
+            self.update()
+        elif key == Qt.Key.Key_Escape and self._drag is not None and self._drag.get("mode") == "ik":
+            if self._drag.get("pushed"):
+                self.ctx.undo_stack.undo()
+            self._drag = None
+            self.update()
+        else:
+            super().keyPressEvent(event)
+
+
+class ClipControls(QWidget):
+    """Play / pause, speed, play mode and a progress bar over the document's frame range,
+    synced with ``ctx.frame`` (the timeline sees every frame it shows)."""
+
+    MODES = ("loop", "once", "ping-pong", "continue")
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None, window: Any = None) -> None:
+        super().__init__(parent)
+        from qtanimator.core.clip import ClipPlayer
+
+        self.ctx = ctx
+        self.window_ = window
+        self._announcing = False
+        self.player = ClipPlayer(0.0, 1.0)
+        layout = QHBoxLayout(self)
+        layout.setContentsMargins(4, 2, 4, 2)
+        self.play_button = QToolButton(self)
+        self.play_button.setObjectName("viewportPlay")
+        self.play_button.setCheckable(True)
+        self.play_button.setText("Play")
+        self.play_button.toggled.connect(self.set_playing)
+        self.speed = QDoubleSpinBox(self)
+        self.speed.setObjectName("viewportSpeed")
+        self.speed.setRange(-4.0, 4.0)
+        self.speed.setSingleStep(0.25)
+        self.speed.setValue(1.0)
+        self.speed.setSuffix("×")
+        self.speed.valueChanged.connect(self._on_speed)
+        self.mode = QComboBox(self)
+        self.mode.setObjectName("viewportPlayMode")
+        self.mode.addItems(list(self.MODES))
+        self.mode.currentTextChanged.connect(self._on_mode)
+        self.progress = QProgressBar(self)
+        self.progress.setObjectName("viewportProgress")
+        self.progress.setRange(0, 1000)
+        self.progress.setTextVisible(True)
+        self.progress.setFormat("%p%")
+        self.progress.mousePressEvent = self._seek_click  # type: ignore[method-assign]
+        layout.addWidget(self.play_button)
+        layout.addWidget(QLabel("Speed", self))
+        layout.addWidget(self.speed)
+        layout.addWidget(self.mode)
+        layout.addWidget(self.progress, 1)
+        self._clock = QElapsedTimer()
+        self._timer = QTimer(self)
+        self._timer.setTimerType(Qt.TimerType.PreciseTimer)
+        self._timer.setInterval(8)
+        self._timer.timeout.connect(self._tick)
+        self._setting_frame = False
+        ctx.frameChanged.connect(self._on_frame)
+        ctx.playingChanged.connect(self._on_other_playing)
+        self._on_frame(ctx.frame)
+
+    def clip_range(self) -> tuple[float, float]:
+        first, last = self.ctx.doc.frame_range
+        return self.ctx.doc.frame_to_time(first), self.ctx.doc.frame_to_time(max(last, first))
+
+    @property
+    def playing(self) -> bool:
+        return self._timer.isActive()
+
+    def set_playing(self, playing: bool, announce: bool = True) -> None:
+        """Start or stop playback; ``announce`` tells the other editors (ctx.playingChanged)."""
+        if playing == self.playing:
+            self.play_button.setChecked(playing)
+            return
+        if playing:
+            other = getattr(self.window_, "playback", None)   # the timeline's playback
+            if other is not None and getattr(other, "playing", False):
+                other.pause()
+            from qtanimator.core.clip import ClipPlayer
+
+            start, end = self.clip_range()
+            self.player = ClipPlayer(start, end, self.mode.currentText(), self.speed.value())
+            t = self.ctx.time
+            if self.mode.currentText() == "once" and t >= end:
+                t = start
+            self.player.elapsed = t - start if start <= t <= end or self.mode.currentText() == "continue" else 0.0
+            self._clock.start()
+            self._timer.start()
+        else:
+            self._timer.stop()
+        self.play_button.setChecked(playing)
+        self.play_button.setText("Pause" if playing else "Play")
+        if announce:
+            self._announcing = True
+            try:
+                self.ctx.playingChanged.emit(playing)
+            finally:
+                self._announcing = False
+
+    def step(self, dt: float) -> None:
+        """Advance playback by ``dt`` wall seconds (the timer calls this; tests may too)."""
+        t = self.player.advance(dt)
+        self._setting_frame = True
+        try:
+            self.ctx.set_frame(self.ctx.doc.time_to_frame(t))
+        finally:
+            self._setting_frame = False
+        if self.player.finished:
+            self.set_playing(False)
+
+    def _tick(self) -> None:
+        self.step(self._clock.restart() / 1000.0)
+
+    def _on_speed(self, value: float) -> None:
+        self.player.speed = float(value)
+
+    def _on_mode(self, mode: str) -> None:
+        from qtanimator.core.clip import PlayMode
+
+        t = self.player.time
+        self.player.mode = PlayMode(mode)
+        self._seek_time(t)
+
+    def _seek_time(self, t: float) -> None:
+        start = self.player.start
+        self.player.elapsed = max(t - start, 0.0) if self.player.mode.value != "continue" else t - start
+
+    def _on_frame(self, frame: float) -> None:
+        start, end = self.clip_range()
+        t = self.ctx.doc.frame_to_time(frame)
+        u = 0.0 if end <= start else (t - start) / (end - start)
+        self.progress.setValue(int(round(1000 * min(max(u, 0.0), 1.0))))
+        if not self._setting_frame and self.playing:
+            self._seek_time(t)
+
+    def _on_other_playing(self, playing: bool) -> None:
+        if playing and self.playing and not self._announcing:
+            self.set_playing(False, announce=False)
+
+    def _seek_click(self, event: QMouseEvent) -> None:
+        start, end = self.clip_range()
+        u = min(max(event.position().x() / max(self.progress.width(), 1), 0.0), 1.0)
+        self.ctx.set_frame(round(self.ctx.doc.time_to_frame(start + u * (end - start))))
+
+
+class ViewportPanel(QWidget):
+    """The "3D" tab: display toolbar, GL view, clip playback controls."""
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None, window: Any = None) -> None:
+        super().__init__(parent)
+        self.setObjectName("viewportPanel")
+        self.view = Viewport3D(ctx, self)
+        self.controls = ClipControls(ctx, self, window)
+        bar = QHBoxLayout()
+        bar.setContentsMargins(4, 2, 4, 2)
+        self.show_mode = QComboBox(self)
+        self.show_mode.setObjectName("viewportShow")
+        self.show_mode.addItems(["Skin and skeleton", "Skin only", "Skeleton only"])
+        self.show_mode.currentIndexChanged.connect(self._on_show)
+        self.shading = QComboBox(self)
+        self.shading.setObjectName("viewportShading")
+        self.shading.addItems(["Auto normals", "Faceted", "Smooth"])
+        self.shading.currentIndexChanged.connect(self._on_shading)
+        self.weights = QComboBox(self)
+        self.weights.setObjectName("viewportWeights")
+        self.weights.addItems(["No weights", "All joint weights", "Selected joint weight"])
+        self.weights.currentIndexChanged.connect(lambda _i: self._on_weights())
+        ctx.selectionChanged.connect(lambda _a, _j: self._on_weights())
+        self.wireframe = QCheckBox("Wireframe", self)
+        self.wireframe.setObjectName("viewportWireframe")
+        self.wireframe.toggled.connect(self._on_wireframe)
+        self.grid = QCheckBox("Grid", self)
+        self.grid.setObjectName("viewportGrid")
+        self.grid.setChecked(True)
+        self.grid.toggled.connect(self._on_grid)
+        self.chain = QSpinBox(self)
+        self.chain.setObjectName("viewportIkChain")
+        self.chain.setRange(1, 20)
+        self.chain.setValue(self.view.ik_chain_length)
+        self.chain.setPrefix("IK chain ")
+        self.chain.valueChanged.connect(lambda v: setattr(self.view, "ik_chain_length", int(v)))
+        frame = QToolButton(self)
+        frame.setObjectName("viewportFrame")
+        frame.setText("Frame")
+        frame.setToolTip("Frame the selection (F)")
+        frame.clicked.connect(self.view.frame_selection)
+        self.status = QLabel(self)
+        self.status.setObjectName("viewportStatus")
+        self.view.frameRendered.connect(self._on_frame_rendered)
+        for w in (self.show_mode, self.shading, self.weights, self.wireframe, self.grid, self.chain, frame):
+            bar.addWidget(w)
+        bar.addStretch(1)
+        bar.addWidget(self.status)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        layout.setSpacing(0)
+        layout.addLayout(bar)
+        layout.addWidget(self.view, 1)
+        layout.addWidget(self.controls)
+
+    def _on_show(self, index: int) -> None:
+        self.view.options.show_skin = index in (0, 1)
+        self.view.options.show_skeleton = index in (0, 2)
+        self.view.update()
+
+    def _on_shading(self, index: int) -> None:
+        self.view.options.faceted = (None, True, False)[index]
+        self.view.update()
+
+    def _on_weights(self) -> None:
+        index = self.weights.currentIndex()
+        mode = WEIGHTS_OFF
+        if index == 1:
+            mode = WEIGHTS_ALL
+        elif index == 2:
+            asset, joint = self.view.ctx.selection
+            mode = WEIGHTS_OFF
+            if asset and joint:
+                from qtanimator.render.scene3d import joint_index
+
+                skel = getattr(self.view.ctx.doc.runtime.get(asset), "skeleton", None)
+                if skel is not None:
+                    try:
+                        mode = joint_index(skel, joint)
+                    except (KeyError, ValueError):
+                        mode = WEIGHTS_OFF
+        self.view.options.weight_mode = mode
+        self.view.options.weight_asset = self.view.ctx.selection[0] if index == 2 else None
+        self.view.update()
+
+    def _on_wireframe(self, on: bool) -> None:
+        self.view.options.wireframe = on
+        self.view.update()
+
+    def _on_grid(self, on: bool) -> None:
+        self.view.options.show_grid = on
+        self.view.update()
+
+    def _on_frame_rendered(self, ms: float) -> None:
+        text = f"{ms:.1f} ms"
+        if self.view.last_error:
+            text = f"{self.view.last_error}  ·  {text}"
+        self.status.setText(text)
+
+
+def install(window: Any) -> None:
+    panel = ViewportPanel(window.ctx, window, window)
+    window.viewport_panel = panel
+    window.viewport3d = panel.view
+    window.add_central(panel, "3D")
+    frame = window._action("actionFrameSelection3d", "Frame Selection (3D)", panel.view.frame_selection)
+    window.view_menu.addAction(frame)
+
+
+__all__ = ["ClipControls", "LiveCloths", "Viewport3D", "ViewportPanel", "install", "ClothDraw"]

@@ -1,0 +1,95 @@
+"""The cloth dock: one editor per ClothParams field, live edits through commands."""
+
+from __future__ import annotations
+
+from dataclasses import fields
+
+import pytest
+from PySide6.QtWidgets import QCheckBox, QComboBox, QDockWidget, QDoubleSpinBox, QPushButton, QSpinBox
+
+from qtanimator.core.cloth import ClothParams
+from qtanimator.document.cloth import cloth_params
+from qtanimator.ui import cloth_panel
+from qtanimator.ui.main_window import MainWindow
+
+
+def _window(qtbot):
+    w = MainWindow(install_editors=False)
+    cloth_panel.install(w)
+    qtbot.addWidget(w)
+    return w
+
+
+def test_every_parameter_has_an_editor_and_add_creates_a_cloth(qtbot):
+    w = _window(qtbot)
+    assert w.findChild(QDockWidget, "clothDock") is not None
+    assert set(w.cloth_panel.editors) == {f.name for f in fields(ClothParams)}
+    assert not w.findChild(QSpinBox, "cloth_rows").isEnabled()     # no cloth yet
+    w.findChild(QPushButton, "clothAdd").click()
+    assert [a.kind for a in w.doc.assets.values()] == ["cloth"]
+    assert w.findChild(QSpinBox, "cloth_rows").isEnabled()
+    assert w.findChild(QComboBox, "clothAsset").currentText() == "cloth"
+
+
+def test_edits_change_the_cloth_and_undo(qtbot):
+    w = _window(qtbot)
+    w.cloth_panel.add_cloth()
+    doc = w.doc
+    stiff = w.findChild(QDoubleSpinBox, "cloth_structural_stiffness")
+    for v in (300.0, 350.0, 400.0):
+        stiff.setValue(v)
+    assert cloth_params(doc, "cloth").structural_stiffness == 400.0
+    w.findChild(QComboBox, "cloth_integrator").setCurrentText("implicit")
+    assert cloth_params(doc, "cloth").integrator == "implicit"
+    w.findChild(QDoubleSpinBox, "cloth_wind_x").setValue(2.0)
+    assert cloth_params(doc, "cloth").wind == (2.0, 0.0, 0.0)
+    w.findChild(QDoubleSpinBox, "cloth_wind_speed").setValue(5.0)
+    assert cloth_params(doc, "cloth").wind == (5.0, 0.0, 0.0)
+    w.findChild(QCheckBox, "cloth_sphere_on").setChecked(True)
+    assert len(cloth_params(doc, "cloth").spheres) == 1
+    w.findChild(QSpinBox, "cloth_rows").setValue(12)
+    assert cloth_params(doc, "cloth").rows == 12
+    count = w.ctx.undo_stack.count()
+    w.ctx.undo_stack.undo()
+    assert cloth_params(doc, "cloth").rows == 20 and w.findChild(QSpinBox, "cloth_rows").value() == 20
+    # the stiffness drag was one undo step
+    while w.ctx.undo_stack.index() > 1:
+        w.ctx.undo_stack.undo()
+    assert cloth_params(doc, "cloth").structural_stiffness == 200.0
+    assert count - 1 == 5
+
+
+def test_an_invalid_value_is_refused_with_a_message(qtbot):
+    w = _window(qtbot)
+    w.cloth_panel.add_cloth()
+    assert not w.cloth_panel.edit("custom_pins", [100000])   # no such particle
+    assert w.cloth_panel.message.text()
+
+
+@pytest.mark.gl
+def test_interactive_pause_and_reset_drive_the_viewport_cloth(qtbot):
+    from qtanimator.ui import viewport
+
+    w = MainWindow(install_editors=False)
+    viewport.install(w)
+    cloth_panel.install(w)
+    qtbot.addWidget(w)
+    w.cloth_panel.add_cloth()
+    view = w.viewport3d
+    live = w.findChild(QCheckBox, "clothLive")
+    live.setChecked(True)
+    assert view.live.enabled and "cloth" in view.live.cloths
+    cloth = view.live.cloths["cloth"]
+    w.findChild(QPushButton, "clothPause").setChecked(True)
+    assert view.live.paused
+    view.live.paused = False
+    view.live.step(1 / 60)
+    assert cloth.time > 0
+    w.findChild(QPushButton, "clothReset").click()
+    assert cloth.time == 0
+    # a parameter edit reaches the live cloth
+    w.findChild(QDoubleSpinBox, "cloth_gravity").setValue(3.0)
+    view.live.sync(w.doc)
+    assert view.live.cloths["cloth"].params.gravity == 3.0
+    view.set_live_cloth(False)
+    assert not live.isChecked()

@@ -1,0 +1,109 @@
+"""File > Export Animation…: the dialog, the progress dialog and its Cancel."""
+
+from __future__ import annotations
+
+import importlib
+
+from PySide6.QtCore import QTimer
+from PySide6.QtGui import QAction
+from PySide6.QtWidgets import (
+    QApplication,
+    QComboBox,
+    QDialogButtonBox,
+    QLineEdit,
+    QProgressDialog,
+    QPushButton,
+    QSpinBox,
+)
+
+from qtanimator.ui.export_dialog import ExportSettings, run_export
+from qtanimator.ui.main_window import EDITOR_MODULES, MainWindow
+
+MINE = ("rig_editor", "timeline", "joint_tree", "properties", "export_dialog", "recovery")
+
+
+def make_window(qtbot) -> MainWindow:
+    window = MainWindow(install_editors=False)
+    for name in EDITOR_MODULES:
+        if name.rsplit(".", 1)[1] in MINE:
+            try:
+                module = importlib.import_module(name)
+            except ModuleNotFoundError:
+                continue
+            module.install(window)
+    qtbot.addWidget(window)
+    window.show()
+    qtbot.waitExposed(window)
+    return window
+
+
+def test_export_dialog_writes_a_png_sequence(qtbot, shared_data, tmp_path):
+    window = make_window(qtbot)
+    assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
+    out = tmp_path / "frames"
+    done: list[bool] = []
+
+    def fill_in() -> None:
+        dialog = QApplication.activeModalWidget()
+        assert dialog is not None and dialog.objectName() == "exportDialog"
+        dialog.findChild(QComboBox, "exportFormat").setCurrentIndex(0)
+        dialog.findChild(QLineEdit, "exportPath").setText(str(out))
+        dialog.findChild(QSpinBox, "exportWidth").setValue(64)
+        dialog.findChild(QSpinBox, "exportHeight").setValue(48)
+        dialog.findChild(QSpinBox, "exportFirst").setValue(0)
+        dialog.findChild(QSpinBox, "exportLast").setValue(4)
+        box = dialog.findChild(QDialogButtonBox)
+        qtbot.mouseClick(box.button(QDialogButtonBox.StandardButton.Ok), _left())
+        done.append(True)
+
+    QTimer.singleShot(50, fill_in)
+    window.findChild(QAction, "actionExport").trigger()
+    assert done
+    files = sorted(out.glob("*.png"))
+    assert len(files) == 5
+    from PIL import Image
+
+    img = Image.open(files[0])
+    assert img.size == (64, 48)
+    # The arm is drawn: not every pixel is the background.
+    import numpy as np
+
+    pixels = np.asarray(img.convert("RGB")).reshape(-1, 3)
+    assert len(np.unique(pixels, axis=0)) > 1
+
+
+def _left():
+    from PySide6.QtCore import Qt
+
+    return Qt.MouseButton.LeftButton
+
+
+def test_gif_export_and_cancel(qtbot, shared_data, tmp_path):
+    window = make_window(qtbot)
+    assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
+    from qtanimator.core.channel import Key
+    from qtanimator.document.commands import SetKeys
+
+    doc = window.doc
+    window.ctx.push(SetKeys(doc, {"arm/joint1/angle": Key(0.0, 0.0)}))
+    window.ctx.push(SetKeys(doc, {"arm/joint1/angle": Key(3 / doc.fps, 1.0)}))  # every frame differs
+    gif = tmp_path / "arm.gif"
+    n = run_export(window, ExportSettings(out=str(gif), fmt="gif", width=40, height=30, fps=30, first=0, last=3))
+    assert n == 4 and gif.stat().st_size > 0
+    from qtanimator.render.export import count_video_frames
+
+    assert count_video_frames(gif) == 4
+    # MP4: the suffix is added from the format.
+    n = run_export(window, ExportSettings(out=str(tmp_path / "arm"), fmt="mp4", width=32, height=32, fps=30,
+                                          first=0, last=2))
+    assert n == 3 and count_video_frames(tmp_path / "arm.mp4") == 3
+
+    def press_cancel() -> None:
+        dialog = window.export_progress
+        assert isinstance(dialog, QProgressDialog) and dialog.objectName() == "exportProgress"
+        qtbot.mouseClick(dialog.findChild(QPushButton), _left())
+
+    QTimer.singleShot(0, press_cancel)
+    written = run_export(window, ExportSettings(out=str(tmp_path / "seq"), fmt="png", width=32, height=32,
+                                                first=0, last=200))
+    assert 0 < written < 201

@@ -1,0 +1,350 @@
+"""The 3D viewport widget: real GL under the private Xvfb, real mouse and key events."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QPoint, Qt
+from PySide6.QtOpenGLWidgets import QOpenGLWidget
+from PySide6.QtWidgets import QTabWidget
+
+from qtanimator.render.gl.camera import OrbitCamera
+from qtanimator.ui import viewport
+from qtanimator.ui.main_window import MainWindow
+
+pytestmark = pytest.mark.gl
+
+
+@pytest.fixture
+def window(qtbot):
+    w = MainWindow(install_editors=False)
+    viewport.install(w)
+    qtbot.addWidget(w)
+    w.resize(420, 360)
+    w.show()
+    qtbot.waitExposed(w)
+    return w
+
+
+def _add_mit(window, shared_data, model="Model1"):
+    from qtanimator.document.character3d import add_character3d_command
+
+    d = shared_data / "mit6837"
+    window.ctx.push(add_character3d_command(window.doc, d / f"{model}.skel", obj_path=d / f"{model}.obj",
+                                            attach_path=d / f"{model}.attach", asset_id="mit"))
+
+
+def _front_camera(view):
+    view.camera = OrbitCamera(azimuth=0.0, inclination=0.0, distance=1.6, target=np.array([0.5, 0.5, 0.5]))
+    view._framed_once = True
+
+
+def test_install_adds_a_3d_tab_with_the_gl_view(window, qtbot):
+    tabs = window.findChild(QTabWidget, "centralTabs")
+    titles = [tabs.tabText(i) for i in range(tabs.count())]
+    assert "3D" in titles
+    view = window.findChild(QOpenGLWidget, "viewport3d")
+    assert view is window.viewport3d
+    fmt = view.format()
+    assert (fmt.majorVersion(), fmt.minorVersion()) >= (3, 3) and fmt.depthBufferSize() >= 24
+    img = view.render_image()
+    assert img.shape[0] > 50 and img.shape[1] > 50
+    # the ground grid draws lines over the background
+    assert len(np.unique(img.reshape(-1, 4)[:, :3], axis=0)) > 5
+    assert "Core" in view.gl_info or "core" in view.gl_info.lower() or view.gl_info
+
+
+def test_orbit_pan_zoom_with_the_mouse(window, qtbot):
+    view = window.viewport3d
+    cam = view.camera
+    az, inc, dist = cam.azimuth, cam.inclination, cam.distance
+    qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=QPoint(100, 100))
+    qtbot.mouseMove(view, QPoint(140, 120))
+    qtbot.mouseMove(view, QPoint(180, 140))
+    qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=QPoint(180, 140))
+    assert cam.azimuth != az and cam.inclination != inc
+    target = np.array(cam.target, dtype=float)
+    qtbot.mousePress(view, Qt.MouseButton.MiddleButton, pos=QPoint(100, 100))
+    qtbot.mouseMove(view, QPoint(150, 100))
+    qtbot.mouseRelease(view, Qt.MouseButton.MiddleButton, pos=QPoint(150, 100))
+    assert np.linalg.norm(np.array(cam.target) - target) > 1e-3
+    from PySide6.QtCore import QPointF
+    from PySide6.QtGui import QWheelEvent
+
+    ev = QWheelEvent(QPointF(100, 100), QPointF(view.mapToGlobal(QPoint(100, 100))), QPoint(0, 0), QPoint(0, 240),
+                     Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier, Qt.ScrollPhase.NoScrollPhase, False)
+    view.wheelEvent(ev)
+    assert cam.distance < dist
+
+
+def test_clicking_a_joint_selects_it(window, qtbot, shared_data):
+    _add_mit(window, shared_data)
+    view = window.viewport3d
+    view.options.show_skin = False
+    _front_camera(view)
+    from qtanimator.document.character3d import pose_skeleton
+
+    skel = pose_skeleton(window.doc, "mit", window.ctx.time)
+    pos = skel.world_matrices()[:, :3, 3]
+    keys = skel.joint_keys()
+    w, h = view.width(), view.height()
+    for joint in (7, 11, 14, 17):   # feet and elbows: nothing in front of them from the front
+        px = view.camera.project(pos[joint], w, h)[0]
+        qtbot.mouseClick(view, Qt.MouseButton.LeftButton, pos=QPoint(int(round(px[0])), int(round(px[1]))))
+        assert window.ctx.selection == ("mit", keys[joint])
+    qtbot.mouseClick(view, Qt.MouseButton.LeftButton, pos=QPoint(3, 3))
+    assert window.ctx.selection == ("", "")
+
+
+def test_selected_joint_is_highlighted(window, qtbot, shared_data):
+    _add_mit(window, shared_data)
+    view = window.viewport3d
+    view.options.show_skin = False
+    view.options.show_grid = False
+    _front_camera(view)
+    before = view.render_image()
+    from qtanimator.document.character3d import pose_skeleton
+
+    skel = pose_skeleton(window.doc, "mit", 0.0)
+    window.ctx.select("mit", skel.joint_keys()[14])
+    after = view.render_image().astype(int)
+    changed = np.any(np.abs(after - before.astype(int)) > 30, axis=2)
+    assert changed.sum() > 5
+    # the highlight is orange: red well above blue where it changed
+    assert (after[changed][:, 0] - after[changed][:, 2]).mean() > 60
+
+
+def test_right_drag_ik_moves_the_joint_and_is_one_undo_step_keyed_now(window, qtbot, shared_data):
+    _add_mit(window, shared_data)
+    view = window.viewport3d
+    view.options.show_skin = False
+    _front_camera(view)
+    window.ctx.set_frame(12)
+    from qtanimator.document.character3d import pose_skeleton
+
+    joint = 14  # right elbow: chain = shoulder, collarbone
+    p0 = pose_skeleton(window.doc, "mit", window.ctx.time).world_matrices()[joint, :3, 3]
+    w, h = view.width(), view.height()
+    start = view.camera.project(p0, w, h)[0]
+    a = QPoint(int(round(start[0])), int(round(start[1])))
+    b = a + QPoint(0, -40)
+    steps = window.ctx.undo_stack.count()
+    qtbot.mousePress(view, Qt.MouseButton.RightButton, pos=a)
+    for k in range(1, 5):
+        qtbot.mouseMove(view, a + QPoint(0, -10 * k))
+    qtbot.mouseRelease(view, Qt.MouseButton.RightButton, pos=b)
+    assert window.ctx.undo_stack.count() == steps + 1
+    skel = pose_skeleton(window.doc, "mit", window.ctx.time)
+    p1 = skel.world_matrices()[joint, :3, 3]
+    moved = view.camera.project(p1, w, h)[0]
+    assert moved[1] < start[1] - 15            # the elbow went up the screen, towards the mouse
+    keyed = [cid for cid in window.doc.channels if cid.startswith("mit/")]
+    assert keyed and all(any(abs(k.time - window.ctx.time) < 1e-9 for k in window.doc.channels[c].keys)
+                         for c in keyed)
+    window.ctx.undo_stack.undo()
+    p2 = pose_skeleton(window.doc, "mit", window.ctx.time).world_matrices()[joint, :3, 3]
+    np.testing.assert_allclose(p2, p0, atol=1e-9)
+
+
+def test_display_modes_change_the_picture(window, qtbot, shared_data):
+    _add_mit(window, shared_data)
+    panel = window.viewport_panel
+    view = panel.view
+    _front_camera(view)
+    both = view.render_image().astype(int)
+    panel.show_mode.setCurrentIndex(2)        # skeleton only
+    skel_only = view.render_image().astype(int)
+    panel.show_mode.setCurrentIndex(1)        # skin only
+    panel.weights.setCurrentIndex(1)          # all weights pseudo-colour
+    weights = view.render_image().astype(int)
+    panel.weights.setCurrentIndex(0)
+    panel.wireframe.setChecked(True)
+    wire = view.render_image().astype(int)
+    for a, b in ((both, skel_only), (both, weights), (both, wire)):
+        assert np.mean(np.any(np.abs(a - b) > 20, axis=2)) > 0.01
+    # the pseudo-colour is colourful: strong saturation somewhere
+    sat = weights[..., :3].max(axis=2) - weights[..., :3].min(axis=2)
+    assert (sat > 100).sum() > 50
+
+
+def test_cloth_keys_move_the_pins_of_the_live_cloth(window, qtbot):
+    from qtanimator.core.cloth import ClothParams
+    from qtanimator.document.cloth import add_cloth_command
+
+    window.ctx.push(add_cloth_command(window.doc, ClothParams(rows=8, cols=8)))
+    view = window.viewport3d
+    view.setFocus()
+    view.set_live_cloth(True)
+    view.live.paused = True
+    cloth = view.live.cloths["cloth"]
+    before = cloth.pin_targets.copy()
+    qtbot.keyClick(view, Qt.Key.Key_D)
+    qtbot.keyClick(view, Qt.Key.Key_D)
+    qtbot.keyClick(view, Qt.Key.Key_Q)
+    np.testing.assert_allclose(cloth.pin_targets - before,
+                               np.tile([2 * viewport.PIN_STEP, viewport.PIN_STEP, 0.0], (len(before), 1)), atol=1e-12)
+    qtbot.keyClick(view, Qt.Key.Key_Z)
+    centre = cloth.pin_targets.mean(axis=0)
+    assert not np.allclose(cloth.pin_targets, before + [2 * viewport.PIN_STEP, viewport.PIN_STEP, 0.0])
+    np.testing.assert_allclose(centre, before.mean(axis=0) + [2 * viewport.PIN_STEP, viewport.PIN_STEP, 0.0],
+                               atol=1e-9)
+    view.live.paused = False
+    view.live.step(1 / 60)
+    np.testing.assert_allclose(cloth.positions[cloth.pinned], cloth.pin_targets, atol=1e-9)
+    view.live.reset()
+    np.testing.assert_allclose(cloth.pin_targets, before)
+    view.set_live_cloth(False)
+
+
+def test_mouse_grab_drags_the_live_cloth(window, qtbot):
+    from qtanimator.core.cloth import ClothParams
+    from qtanimator.document.cloth import add_cloth_command
+
+    window.ctx.push(add_cloth_command(window.doc, ClothParams(rows=8, cols=8, origin=(0.0, 1.5, 0.0))))
+    view = window.viewport3d
+    view.camera = OrbitCamera(azimuth=0.0, inclination=0.0, distance=3.0, target=np.array([0.0, 1.0, 0.0]))
+    view._framed_once = True
+    view.set_live_cloth(True)
+    view.live.paused = True
+    cloth = view.live.cloths["cloth"]
+    w, h = view.width(), view.height()
+    corner = cloth.positions[-1].copy()   # bottom right, not pinned
+    px = view.camera.project(corner, w, h)[0]
+    a = QPoint(int(round(px[0])), int(round(px[1])))
+    qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=a)
+    assert cloth.grabbed is not None
+    qtbot.mouseMove(view, a + QPoint(30, 0))
+    view.live.paused = False
+    view.live.step(1 / 60)
+    assert cloth.positions[cloth.grabbed][0] > corner[0] + 0.05
+    qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=a + QPoint(30, 0))
+    assert cloth.grabbed is None
+    view.set_live_cloth(False)
+
+
+def test_clip_controls_play_modes_drive_the_frame(window, qtbot):
+    controls = window.viewport_panel.controls
+    doc = window.doc
+    start, end = controls.clip_range()
+    window.ctx.set_frame(0)
+    controls.mode.setCurrentText("loop")
+    controls.set_playing(True)
+    assert controls.playing
+    controls.step(1.0)
+    assert window.ctx.frame == pytest.approx(doc.time_to_frame(start + 1.0))
+    assert controls.progress.value() == pytest.approx(1000 * 1.0 / (end - start), abs=1)
+    controls.step(end - start)                      # wraps around
+    assert window.ctx.frame == pytest.approx(doc.time_to_frame(start + 1.0), abs=1e-6)
+    controls.speed.setValue(2.0)
+    controls.step(0.5)
+    assert window.ctx.frame == pytest.approx(doc.time_to_frame(start + 2.0), abs=1e-6)
+    controls.set_playing(False)
+    controls.mode.setCurrentText("once")
+    controls.set_playing(True)
+    controls.step(10 * (end - start))
+    assert window.ctx.frame == pytest.approx(doc.time_to_frame(end))
+    assert not controls.playing and controls.progress.value() == 1000
+    controls.mode.setCurrentText("ping-pong")
+    window.ctx.set_frame(0)
+    controls.speed.setValue(1.0)
+    controls.set_playing(True)
+    controls.step((end - start) + 1.0)
+    assert window.ctx.frame == pytest.approx(doc.time_to_frame(end - 1.0), abs=1e-6)
+    controls.set_playing(False)
+    controls.mode.setCurrentText("continue")
+    window.ctx.set_frame(doc.time_to_frame(end))
+    controls.set_playing(True)
+    controls.step(1.0)
+    assert window.ctx.frame == pytest.approx(doc.time_to_frame(end + 1.0), abs=1e-6)
+    controls.set_playing(False)
+
+
+def test_dragging_a_light_gizmo_moves_the_light_in_one_undo_step(window, qtbot):
+    view = window.viewport3d
+    view.camera = OrbitCamera(azimuth=0.0, inclination=0.0, distance=14.0, target=np.array([0.0, 3.0, 0.0]))
+    view._framed_once = True
+    view.render_image()
+    from qtanimator.render.gl.lights import lights_of
+
+    before = lights_of(window.doc)[0].position.copy()
+    w, h = view.width(), view.height()
+    px = view.camera.project(before, w, h)[0]
+    a = QPoint(int(round(px[0])), int(round(px[1])))
+    qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=a)
+    for k in range(1, 4):
+        qtbot.mouseMove(view, a + QPoint(-10 * k, 0))
+    qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=a + QPoint(-30, 0))
+    after = np.array(window.doc.parameters["light1.position"])
+    assert after[0] < before[0] - 0.3 and abs(after[2] - before[2]) < 1e-6   # moved left in the view plane
+    assert window.ctx.undo_stack.count() == 1
+    window.ctx.undo_stack.undo()
+    np.testing.assert_allclose(lights_of(window.doc)[0].position, before)
+
+
+def test_f_frames_the_selection_and_escape_cancels_an_ik_drag(window, qtbot, shared_data):
+    _add_mit(window, shared_data)
+    view = window.viewport3d
+    from qtanimator.document.character3d import pose_skeleton
+
+    skel = pose_skeleton(window.doc, "mit", 0.0)
+    window.ctx.select("mit", skel.joint_keys()[7])
+    view.setFocus()
+    qtbot.keyClick(view, Qt.Key.Key_F)
+    np.testing.assert_allclose(view.camera.target, skel.world_matrices()[7, :3, 3])
+    _front_camera(view)
+    view.options.show_skin = False
+    p0 = skel.world_matrices()[14, :3, 3]
+    px = view.camera.project(p0, view.width(), view.height())[0]
+    a = QPoint(int(round(px[0])), int(round(px[1])))
+    steps = window.ctx.undo_stack.count()
+    qtbot.mousePress(view, Qt.MouseButton.RightButton, pos=a)
+    qtbot.mouseMove(view, a + QPoint(0, -20))
+    assert window.ctx.undo_stack.count() == steps + 1
+    qtbot.keyClick(view, Qt.Key.Key_Escape)
+    qtbot.mouseRelease(view, Qt.MouseButton.RightButton, pos=a + QPoint(0, -20))
+    np.testing.assert_allclose(pose_skeleton(window.doc, "mit", 0.0).world_matrices()[14, :3, 3], p0, atol=1e-9)
+
+
+def test_an_asset_that_cannot_be_drawn_is_reported_and_the_rest_still_draws(window, qtbot):
+    from qtanimator.document.cloth import add_cloth_command
+    from qtanimator.document.commands import AddAsset
+    from qtanimator.document.document import Asset
+    from qtanimator.render.gl.renderer import ClothDraw
+
+    window.ctx.push(AddAsset(Asset("ghost", "character3d"), runtime=None))
+    window.ctx.push(add_cloth_command(window.doc))
+    view = window.viewport3d
+    items = view.build_items()
+    assert [type(i) for i in items] == [ClothDraw]
+    assert "ghost" in view.last_error
+    view.render_image()
+    assert "ghost" in window.viewport_panel.status.text()
+
+
+def test_clip_controls_announce_playing_and_yield_to_the_timeline(window, qtbot):
+    controls = window.viewport_panel.controls
+    seen = []
+    window.ctx.playingChanged.connect(seen.append)
+    controls.play_button.click()
+    assert controls.playing and seen == [True]
+    window.ctx.playingChanged.emit(True)        # another player (the timeline) starts
+    assert not controls.playing and controls.play_button.text() == "Play"
+    assert seen == [True, True]                 # stopping for it announced nothing
+
+
+def test_live_cloth_runs_on_the_timer_at_a_fixed_step(window, qtbot):
+    from qtanimator.core.cloth import ClothParams
+    from qtanimator.document.cloth import add_cloth_command
+
+    window.ctx.push(add_cloth_command(window.doc, ClothParams(rows=6, cols=6)))
+    view = window.viewport3d
+    view.set_live_cloth(True)
+    cloth = view.live.cloths["cloth"]
+    qtbot.waitUntil(lambda: cloth.time > 0.05, timeout=5000)
+    steps = cloth.time / viewport.SIM_DT
+    assert abs(steps - round(steps)) < 1e-6
+    view.live.paused = True
+    t = cloth.time
+    qtbot.wait(100)
+    assert cloth.time == t
+    view.set_live_cloth(False)
