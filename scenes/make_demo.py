@@ -1,22 +1,63 @@
 """Regenerate ``scenes/demo/demo.qtanim`` (run: ``.venv/bin/python scenes/make_demo.py``).
 
-The demo project holds Pip (``scenes/demo/pip.svg``: a waving character carrying a lantern
-on a two-link chain, a coupled double pendulum, and wearing a pendulum earring) and the
-pendulum clock (``scenes/pendulum_clock.svg``). Saved through ``save_document`` so the file
-is exactly what the program writes.
+The demo project combines the bundled scenes:
+
+* 2D (the rig editor): Pip (``scenes/demo/pip.svg``: a waving character carrying a lantern
+  on a two-link chain, a coupled double pendulum, and wearing a pendulum earring), the
+  pendulum clock (``scenes/pendulum_clock.svg``) and Robo (``scenes/robot/robot.svg``) with
+  the linear-key walk of ``scenes/robot/robot.qtanim``, moved to the right of the clock;
+* 3D (the viewport): the skinned arm of ``scenes/arm3d`` with its ``arm_wave.anim`` loop, and
+  a small flag (a mass-spring cloth pinned along its left edge) in a gusty wind, to the
+  arm's left so it never hides it.
+
+Saved through ``save_document`` so the file is exactly what the program writes; the asset
+sources are stored relative to ``scenes/demo/``.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 
 from qtanimator.core.channel import Key
-from qtanimator.document import Document, SetKeys, SetParameter, save_document
+from qtanimator.core.cloth import ClothParams, pins_from_cells
+from qtanimator.document import Document, SetChannels, SetKeys, SetParameter, open_document, save_document
 from qtanimator.document.character2d import add_characters_command, angle_channel_id, position_channel_ids
+from qtanimator.document.character3d import add_character3d_command
+from qtanimator.document.cloth import add_cloth_command
 
 HERE = Path(__file__).resolve().parent
 FPS = 60.0
+ROBOT_SHIFT = 1130.0  # Robo's rest hip is at x = 300 in robot.svg; walk it right of the clock
+FLAG_ROWS, FLAG_COLS = 12, 18
+
+
+def flag_params() -> ClothParams:
+    """A 1.2 m × 0.8 m flag whose pinned left edge stands at x = −2.3, left of the arm."""
+    return ClothParams(
+        rows=FLAG_ROWS, cols=FLAG_COLS, width=1.2, height=0.8, total_mass=0.6,
+        structural_stiffness=200.0, structural_damping=0.2,
+        shear_stiffness=80.0, shear_damping=0.1,
+        bend_stiffness=8.0, bend_damping=0.02,
+        drag_coefficient=1.0, air_density=1.225,
+        wind=(6.0, 0.0, 1.5), turbulence=0.35, turbulence_seed=11,
+        ground_enabled=True, ground_height=0.0,
+        pin_mode="custom", custom_pins=pins_from_cells(FLAG_COLS, [(r, 0) for r in range(FLAG_ROWS)]),
+        substeps=16, origin=(-1.7, 2.6, -0.3), orientation=(0.0, 0.0, 0.0),
+    )
+
+
+def add_robot(doc: Document) -> None:
+    """Robo and the channels of ``scenes/robot/robot.qtanim`` (its x keys shifted right)."""
+    add_characters_command(doc, HERE / "robot" / "robot.svg").do(doc)
+    walk = open_document(HERE / "robot" / "robot.qtanim")
+    changes = {}
+    for cid, channel in walk.channels.items():
+        if cid == position_channel_ids("robot")[0]:
+            channel = channel.with_keys([replace(k, value=k.value + ROBOT_SHIFT) for k in channel.keys])
+        changes[cid] = (None, channel)
+    SetChannels("Robot walk (linear keys)", changes).do(doc)
 
 
 def build() -> Document:
@@ -44,6 +85,11 @@ def build() -> Document:
         for t, v in values:
             SetKeys(doc, {cid: Key(float(t), float(v))}).do(doc)
     SetParameter(doc, "pip.pendulum.damping", 0.4).do(doc)
+    add_robot(doc)
+
+    arm = HERE / "arm3d"
+    add_character3d_command(doc, arm / "arm.skel", arm / "arm.skin", arm / "arm_wave.anim", asset_id="arm").do(doc)
+    add_cloth_command(doc, flag_params(), asset_id="flag").do(doc)
     return doc
 
 

@@ -287,3 +287,42 @@ def test_svg_numbers_are_short_and_clean() -> None:
     # The rig convention: positive angles turn counter-clockwise on a y-down screen.
     (x, y), = sw.rotate_points([(1.0, 0.0)], math.pi / 2, (0.0, 0.0))
     assert (round(x, 12), round(y, 12)) == (0.0, -1.0)
+
+
+# ------------------------------------------------------------------ pixels
+def _ink(rgba: np.ndarray, background: tuple[int, int, int]) -> np.ndarray:
+    """Mask of pixels that differ from the background colour."""
+    return np.abs(rgba[..., :3].astype(int) - np.array(background)).sum(axis=2) > 30
+
+
+@pytest.mark.parametrize("scene,times", [
+    ("flappy_hop.qtanim", (0.0, 0.25)), ("robot/robot.qtanim", (0.0, 1.0)), ("pencil_path.qtanim", (0.0, 2.0)),
+    ("telescope_chain.svg", (0.0,)),
+])
+def test_2d_scenes_draw_and_move(qapp, scene: str, times: tuple[float, ...]) -> None:
+    from qtanimator.render.cli_render import load_scene
+    from qtanimator.render.painter2d import animation_bounds, image_to_array, render_frame
+
+    doc = load_scene(SCENES / scene)
+    view = animation_bounds(doc, [t / 10 for t in range(0, 41)])  # a steady camera, as `render` uses
+    frames = [image_to_array(render_frame(doc, t, (160, 120), "white", view=view)) for t in times]
+    for f in frames:
+        assert 0.03 < _ink(f, (255, 255, 255)).mean() < 0.9
+    if len(frames) > 1:
+        assert (np.abs(frames[0].astype(int) - frames[1].astype(int)).sum(axis=2) > 30).mean() > 0.01
+
+
+@pytest.mark.gl
+def test_3d_scenes_render_and_move(qapp) -> None:
+    from qtanimator.render.gl.renderer import ViewOptions
+    from qtanimator.render.render3d import render_frames_3d
+
+    plain = ViewOptions(show_grid=False, show_lights=False, show_skeleton=False, background=(0, 0, 0, 1))
+    arm = open_document(SCENES / "arm3d" / "arm3d.qtanim")
+    a0, a1 = render_frames_3d(arm, (0.0, 0.5), (160, 120), options=plain)
+    cloth = open_document(SCENES / "cloth" / "cloth.qtanim")
+    c0, c1 = render_frames_3d(cloth, (0.0, 0.5), (160, 120), options=plain)
+    for img in (a0, a1, c0, c1):
+        assert 0.01 < _ink(img, (0, 0, 0)).mean() < 0.9
+    for first, later in ((a0, a1), (c0, c1)):
+        assert (_ink(first, (0, 0, 0)) != _ink(later, (0, 0, 0))).mean() > 0.01

@@ -2,7 +2,10 @@
 
 An asset of kind :data:`ASSET_KIND` has the ``.skel`` file as its ``source`` and the
 optional properties ``skin_file`` and ``anim_file`` (CSE 169) or ``obj_file`` and
-``attach_file`` (MIT 6.837). The loaded :class:`Character3D` lives in ``doc.runtime``.
+``attach_file`` (MIT 6.837). The source may also be a ``.bvh`` file (skeleton with one
+rotation order per joint; its motion lives in the document's channels) or a ``.glb`` /
+``.gltf`` file (see :mod:`qtanimator.document.import3d`). The loaded :class:`Character3D`
+lives in ``doc.runtime``.
 
 Channels (document channel ids):
 
@@ -27,7 +30,7 @@ import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Key
 from qtanimator.core.clip import ROOT, AnimationClip, channel_count, channel_target
-from qtanimator.core.skeleton import Skeleton, axis_index
+from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Skeleton, axis_index
 from qtanimator.core.skinning import (
     Skin,
     SkinBinding,
@@ -40,6 +43,7 @@ from qtanimator.document.commands import AddAsset, Command, Macro, SetAssetPrope
 from qtanimator.document.document import Asset, Document, channel_id
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.attach import load_attach
+from qtanimator.formats.bvh import load_bvh
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.obj import Mesh, load_obj
 from qtanimator.formats.skel import load_skel
@@ -53,7 +57,7 @@ JOINT_DOFS = ("rx", "ry", "rz")
 
 __all__ = [
     "ASSET_KIND", "Character3D", "add_character3d_command", "channel_dofs", "channel_ids", "character",
-    "clip_from_document", "dof_channel_id",
+    "clip_from_document", "dof_channel_id", "load_bvh_character",
     "load_anim_command", "load_character3d", "load_character3d_asset", "pose_skeleton", "set_dof_command",
     "set_dofs_command", "skinned_mesh", "world_matrices",
 ]
@@ -107,10 +111,37 @@ def load_character3d(skel_path: str | os.PathLike[str], skin_path: str | os.Path
     return Character3D(skeleton, skin, mesh, clip, faceted)
 
 
+def load_bvh_character(path: str | os.PathLike[str]) -> tuple[Character3D, list[Channel | None]]:
+    """A character from a ``.bvh`` file and its motion as channels in the ``.anim`` layout
+    (root x, y, z, then x, y, z rotation per joint; None where the file has no channel).
+
+    The skeleton's DOFs hold the first frame's pose. Raises FormatError for a bad file or a
+    hierarchy a skeleton cannot hold (several roots, position channels below the root).
+    """
+    clip = load_bvh(path)
+    try:
+        skeleton, channels = clip.to_skeleton()
+    except ValueError as exc:
+        raise FormatError(f"{exc}.", path) from exc
+    skeleton.dialect = "bvh"
+    for joint in skeleton.joints:
+        # BVH has no boxes: default boxes make the viewport draw spheres and bones.
+        joint.boxmin = np.array(DEFAULT_BOXMIN)
+        joint.boxmax = np.array(DEFAULT_BOXMAX)
+    return Character3D(skeleton), channels
+
+
 def load_character3d_asset(asset: Asset) -> Character3D:
     """The registered loader for :data:`ASSET_KIND` (a project being opened)."""
     if not asset.source:
         raise FormatError(f"3D character {asset.id!r} has no skeleton file.")
+    suffix = Path(asset.source).suffix.lower()
+    if suffix == ".bvh":
+        return load_bvh_character(asset.source)[0]
+    if suffix in (".glb", ".gltf"):
+        from qtanimator.document.import3d import load_gltf_character_asset
+
+        return load_gltf_character_asset(asset)
     p = asset.properties
     return load_character3d(asset.source, p.get("skin_file") or None, p.get("anim_file") or None,
                             p.get("obj_file") or None, p.get("attach_file") or None)

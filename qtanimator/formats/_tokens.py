@@ -150,6 +150,8 @@ class Tokens:
             if not (math.isfinite(f) and f == int(f) and abs(f) < 2**53):
                 self.error(f"expected a whole number for {what}, found '{_show(tok)}'.", self.pos - 1)
             v = int(f)
+        if abs(v) >= 2**53:  # no count or index is this large; numpy could not hold it either
+            self.error(f"{what} is out of range, found '{_show(tok)}'.", self.pos - 1)
         if lo is not None and v < lo:
             self.error(f"{what} must be at least {lo}, found {v}.", self.pos - 1)
         if hi is not None and v > hi:

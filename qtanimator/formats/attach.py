@@ -71,10 +71,17 @@ def _line_of_token(text: str, index: int) -> int:
 
 def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
     text = read_text(path)
-    lines = [ln.split() for ln in split_lines(text) if ln.strip()]
+    numbered = [(n, ln.split()) for n, ln in enumerate(split_lines(text), start=1) if ln.strip()]
+    if not numbered:
+        raise FormatError("the file holds no weights; an .attach file has one line of weights per vertex.",
+                          path, 1)
+    lines = [words for _, words in numbered]
     widths = sorted({len(ln) for ln in lines})
     if len(widths) != 1:
-        raise FormatError(f"the lines have different numbers of weights ({widths}).", path)
+        first = len(lines[0])
+        number, words = next((n, w) for n, w in numbered if len(w) != first)
+        raise FormatError(f"this line has {len(words)} weights but the first has {first}; every vertex "
+                          "needs one weight per joint after the root.", path, number)
     weights = parse_attach(text, len(lines), widths[0] + 1, path)
     nonzero = (weights != 0).sum(axis=1)
     sums = weights.sum(axis=1)

@@ -400,6 +400,8 @@ class _Parser:
         tok = self.next(what)
         if not _INT.fullmatch(tok.text):
             raise self.error(f"expected {what} (a whole number), found '{_show(tok.text)}'.", tok)
+        if len(tok.text.lstrip("+-")) > 15:  # beyond any real count (and int() refuses > 4300 digits)
+            raise self.error(f"{what} is too large: '{_show(tok.text)}'.", tok)
         return int(tok.text), tok
 
     def rest_of_line(self, line: int) -> list[_Tok]:

@@ -128,6 +128,8 @@ def parse_obj(text: str, path: str | os.PathLike[str] | None = None) -> Mesh:
             faces.append((number, vi, ti, ni))
     if pending:
         raise FormatError("the file ends with a '\\' line continuation.", path, pending_line)
+    if not positions:
+        raise FormatError("the file has no vertices ('v x y z' lines), so it is not an OBJ mesh.", path, 1)
     nv = len(positions)
     tris: list[list[int]] = []
     tri_t: list[list[int]] = []

@@ -13,15 +13,23 @@ import os
 import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import Any
+from typing import Any, NoReturn
 
 import numpy as np
 
 from qtanimator.formats.errors import FormatError
 
 
+class _OneLineParser(argparse.ArgumentParser):
+    """argparse, but a usage error is one line on stderr (exit status 2), as in ``qtanimator``."""
+
+    def error(self, message: str) -> NoReturn:
+        print(f"{self.prog}: {message} (try '{self.prog} --help')", file=sys.stderr)
+        raise SystemExit(2)
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="qtanimator render",
+    p = _OneLineParser(prog="qtanimator render",
                                 description="Render a project or SVG character to PNG frames, a GIF or a video.")
     p.add_argument("scene", help="a project (.qtanim), an SVG character, or a folder of SVG characters")
     p.add_argument("-o", "--output", required=True,
@@ -31,7 +39,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--size", default="960x640", help="image size WxH (default 960x640)")
     p.add_argument("--background", default="white",
                    help="a colour name or #rrggbb, or 'transparent' (default white)")
-    p.add_argument("--view", choices=("2d", "3d"), default="2d", help="the 2D renderer or the 3D viewport")
+    p.add_argument("--view", choices=("auto", "2d", "3d"), default="auto",
+                   help="the 2D renderer or the 3D viewport (default: 2d when the scene has 2D "
+                        "characters, else 3d)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     return p
 
@@ -114,12 +124,54 @@ def frames_2d(doc: Any, times: Sequence[float], size: tuple[int, int], backgroun
         yield image_to_array(render_frame(doc, t, size, background, view=view))
 
 
+_KINDS_2D = ("character2d",)
+_KINDS_3D = ("character3d", "cloth")
+
+
+def choose_view(doc: Any, view: str) -> str:
+    """``2d`` or ``3d`` for ``--view``; ValueError when that view would show nothing."""
+    kinds = {a.kind for a in doc.assets.values()}
+    has_2d = any(k in kinds for k in _KINDS_2D)
+    has_3d = any(k in kinds for k in _KINDS_3D)
+    if view == "auto":
+        if not (has_2d or has_3d):
+            raise ValueError("the scene has nothing to render (no 2D characters, 3D characters or cloth)")
+        return "2d" if has_2d else "3d"
+    if view == "2d" and not has_2d:
+        raise ValueError("the scene has no 2D characters to render; try --view 3d")
+    if view == "3d" and not has_3d:
+        raise ValueError("the scene has no 3D characters or cloth to render; try --view 2d")
+    return view
+
+
+def _negative_frames(argv: Sequence[str]) -> list[str]:
+    """``--frames -5:3`` as ``--frames=-5:3`` (argparse takes ``-5:3`` for an option)."""
+    out: list[str] = []
+    args = list(argv)
+    i = 0
+    while i < len(args):
+        if args[i] == "--frames" and i + 1 < len(args) and args[i + 1].startswith("-") and ":" in args[i + 1]:
+            out.append(f"--frames={args[i + 1]}")
+            i += 2
+            continue
+        out.append(args[i])
+        i += 1
+    return out
+
+
+def _os_message(exc: OSError) -> str:
+    if exc.strerror and exc.filename:
+        return f"cannot write '{exc.filename}': {exc.strerror}"
+    return str(exc)
+
+
 def render_main(argv: Sequence[str]) -> int:
     """Entry point of ``qtanimator render``; returns the exit status."""
-    ns = _parser().parse_args(list(argv))
+    ns = _parser().parse_args(_negative_frames(argv))
     try:
         size = _parse_size(ns.size)
         doc = load_scene(ns.scene)
+        ns.view = choose_view(doc, ns.view)
         if ns.fps is not None:
             if not ns.fps > 0:
                 raise ValueError("--fps must be positive")
@@ -150,8 +202,11 @@ def render_main(argv: Sequence[str]) -> int:
             frames = frames_2d(doc, times, size, ns.background)
         progress = _Progress(len(times), not ns.quiet)
         n = write_frames(frames, ns.output, fps, progress=progress, start=first)
-    except (FormatError, ValueError, OSError) as exc:
+    except (FormatError, ValueError) as exc:
         print(f"qtanimator render: {exc}", file=sys.stderr)
+        return 1
+    except OSError as exc:
+        print(f"qtanimator render: {_os_message(exc)}", file=sys.stderr)
         return 1
     if not ns.quiet:
         print(f"wrote {n} frames to {ns.output}", file=sys.stderr)

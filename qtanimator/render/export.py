@@ -31,6 +31,15 @@ def output_kind(out: str | os.PathLike[str]) -> str:
     s = os.fspath(out)
     suffix = Path(s).suffix.lower()
     if "%" in Path(s).name:
+        name = Path(s).name
+        try:
+            first, second = name % 0, name % 1
+        except (TypeError, ValueError, OverflowError):
+            raise ValueError(f"'{name}' is not a frame pattern; use one number field such as "
+                             "frame_%04d.png") from None
+        if first == second:
+            raise ValueError(f"'{name}' gives every frame the same name; use a number field such as "
+                             "frame_%04d.png")
         return "pattern"
     if suffix == ".gif":
         return "gif"

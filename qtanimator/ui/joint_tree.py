@@ -111,6 +111,17 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
             return m2.key_joint(doc, asset, index, math.radians(value), t, gesture=gesture)
 
         return [DofSpec("angle", math.degrees(angle), -360.0, 360.0, key)]
+    if m3 is not None and kind == m3.ASSET_KIND and runtime is not None and not joint:
+        posed = m3.pose_skeleton(doc, asset, time)
+        root = np.asarray(getattr(posed, "root_translation", np.zeros(3)), dtype=np.float64)
+        specs3 = []
+        for axis_i, axis in enumerate("xyz"):
+            def move3(value: float, t: float, gesture: object, a: str = axis) -> Command:
+                return m3.set_dof_command(doc, asset, None, "t" + a, value, t, gesture=gesture)
+
+            specs3.append(DofSpec(f"translate {axis}", float(root[axis_i]), -TRANSLATION_LIMIT,
+                                  TRANSLATION_LIMIT, move3, ""))
+        return specs3
     if m3 is not None and kind == m3.ASSET_KIND and runtime is not None and joint:
         skeleton = m3.pose_skeleton(doc, asset, time) if hasattr(m3, "pose_skeleton") else runtime
         skel_joints = list(skeleton.joints)

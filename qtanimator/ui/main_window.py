@@ -39,6 +39,7 @@ MAX_RECENT = 10
 EDITOR_MODULES: list[str] = [
     "qtanimator.ui.rig_editor",
     "qtanimator.ui.viewport",
+    "qtanimator.ui.import3d",
     "qtanimator.ui.timeline",
     "qtanimator.ui.joint_tree",
     "qtanimator.ui.properties",
@@ -91,6 +92,7 @@ class MainWindow(QMainWindow):
         self.ctx.undo_stack.cleanChanged.connect(
             lambda _clean: shiboken6.isValid(self) and self._update_title())
         self.ctx.documentReset.connect(self._update_title)
+        self._default_layout()
         self._restore_layout()
         self._update_title()
 
@@ -197,14 +199,23 @@ class MainWindow(QMainWindow):
         if self.maybe_save():
             self.ctx.replace_document(Document())
 
+    def replaces_document(self, path: str | os.PathLike[str]) -> bool:
+        """True for a project (it replaces the document); other files are added to it."""
+        p = Path(path)
+        return not p.is_dir() and p.suffix.lower() not in self.openers
+
+    def open_with_prompt(self, path: str | os.PathLike[str]) -> bool:
+        """Open ``path``, first offering to save unsaved changes if it replaces the document."""
+        if self.replaces_document(path) and not self.maybe_save():
+            return False
+        return self.open_path(path)
+
     def open_dialog(self) -> None:
-        if not self.maybe_save():
-            return
         suffixes = " ".join(f"*{s}" for s in sorted(self.openers))
         filters = f"All supported ({'*.qtanim *.json ' + suffixes});;{PROJECT_FILTER};;All files (*)"
         path, _ = QFileDialog.getOpenFileName(self, "Open", self._last_dir(), filters)
         if path:
-            self.open_path(path)
+            self.open_with_prompt(path)
 
     def open_path(self, path: str | os.PathLike[str]) -> bool:
         """Open a project, or hand another file to the editor that reads it.
@@ -291,7 +302,7 @@ class MainWindow(QMainWindow):
         for path in self.recent_files():
             action = self.recent_menu.addAction(Path(path).name)
             action.setToolTip(path)
-            action.triggered.connect(lambda _c=False, p=path: self.maybe_save() and self.open_path(p))
+            action.triggered.connect(lambda _c=False, p=path: self.open_with_prompt(p))
         self.recent_menu.setEnabled(bool(self.recent_files()))
 
     def _update_title(self) -> None:
@@ -306,11 +317,33 @@ class MainWindow(QMainWindow):
 
     def dropEvent(self, event: QDropEvent) -> None:
         urls = [u.toLocalFile() for u in event.mimeData().urls() if u.isLocalFile()]
-        if urls and self.maybe_save():
-            self.open_path(urls[0])
+        if urls:
+            self.open_with_prompt(urls[0])
             event.acceptProposedAction()
 
     # --------------------------------------------------------------- layout
+    def _default_layout(self) -> None:
+        """First-run arrangement: curve editor above the timeline along the bottom, the
+        joint tree on the left, properties / cloth / lights as tabs on the right."""
+        def dock(name: str) -> QDockWidget | None:
+            return self.findChild(QDockWidget, name)
+
+        curve, timeline = dock("curveEditorDock"), dock("timelineDock")
+        if curve is not None and timeline is not None:
+            self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, curve)
+            self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, timeline)
+            self.splitDockWidget(curve, timeline, Qt.Orientation.Vertical)
+            self.resizeDocks([curve, timeline], [300, 130], Qt.Orientation.Vertical)
+        right = [d for d in (dock("propertiesDock"), dock("clothDock"), dock("lightDock")) if d is not None]
+        for other in right[1:]:
+            self.tabifyDockWidget(right[0], other)
+        if right:
+            right[0].raise_()
+            self.resizeDocks([right[0]], [380], Qt.Orientation.Horizontal)
+        tree = dock("jointTreeDock")
+        if tree is not None:
+            self.resizeDocks([tree], [260], Qt.Orientation.Horizontal)
+
     def _restore_layout(self) -> None:
         s = settings()
         geometry = s.value("window/geometry")

@@ -350,7 +350,7 @@ class PropertiesPanel(QWidget):
             j = skeleton.joints[names.index(joint)]
             form.addRow("Offset", QLabel("({:.3f}, {:.3f}, {:.3f})".format(*(float(v) for v in j.offset))))
             for axis, dof in zip("xyz", j.dofs):
-                form.addRow(f"Limits {axis}", QLabel(f"{math.degrees(dof.min):.1f}° … {math.degrees(dof.max):.1f}°"))
+                form.addRow(f"Limits {axis}", QLabel(_limits_text(float(dof.min), float(dof.max))))
         else:
             form.addRow("Joints", QLabel(str(len(names))))
         return group
@@ -363,6 +363,15 @@ class PropertiesPanel(QWidget):
             self._parameter_editor(form, IK_LABELS.get(path, path), path, default, IK_CHOICES.get(path),
                                    decimals=6)
         return group
+
+
+def _limits_text(lo: float, hi: float) -> str:
+    """Limits in degrees; the skeleton's "unlimited" defaults (huge values) read as none."""
+    def one(v: float) -> str:
+        return "none" if not math.isfinite(v) or abs(v) >= 1e3 else f"{math.degrees(v):.1f}°"
+    if lo >= hi:
+        return f"locked at {one(lo)}"
+    return f"{one(lo)} … {one(hi)}"
 
 
 def install(window: MainWindow) -> None:

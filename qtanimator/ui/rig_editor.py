@@ -805,6 +805,35 @@ def install(window: MainWindow) -> None:
     window.openers["/"] = open_characters
     window.view_menu.addAction(editor.fit_action)
     window.view_menu.addAction(editor.debug_action)
+    delete = QAction("Delete Keys at Current Frame", window)
+    delete.setObjectName("actionDeleteFrameKeys")
+    delete.setToolTip("Delete / Backspace in the 2D editor")
+    delete.triggered.connect(lambda _c=False: editor.view.delete_keys())
+    window.edit_menu.addAction(delete)
+    _restore_editor_settings(editor)
+
+
+def _restore_editor_settings(editor: RigEditor) -> None:
+    """The onion skin's counts and step are user preferences, kept in the program's settings
+    (the IK mode is not: a toggle that silently persisted would surprise)."""
+    from qtanimator.ui.main_window import settings
+
+    s = settings()
+    try:
+        editor.before_box.setValue(int(s.value("rigEditor/onionBefore", editor.before_box.value())))
+        editor.after_box.setValue(int(s.value("rigEditor/onionAfter", editor.after_box.value())))
+        editor.step_box.setValue(int(s.value("rigEditor/onionStep", editor.step_box.value())))
+    except (TypeError, ValueError):
+        pass
+
+    def save() -> None:
+        st = settings()
+        st.setValue("rigEditor/onionBefore", editor.before_box.value())
+        st.setValue("rigEditor/onionAfter", editor.after_box.value())
+        st.setValue("rigEditor/onionStep", editor.step_box.value())
+
+    for box in (editor.before_box, editor.after_box, editor.step_box):
+        box.valueChanged.connect(lambda _v: save())
 
 
 __all__ = ["CharacterItem", "RigEditor", "RigEditorView", "install", "open_characters"]

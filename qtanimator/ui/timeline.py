@@ -150,7 +150,9 @@ class TimelineWidget(QWidget):
             p.drawLine(QPointF(x, bar.top()), QPointF(x, bar.top() + (8 if major else 4)))
             if major:
                 p.setPen(QColor(220, 220, 220))
-                p.drawText(QPointF(x + 2, 13), str(f))
+                label = str(f)
+                tw = p.fontMetrics().horizontalAdvance(label)
+                p.drawText(QPointF(min(x + 2, w - tw - 2), 13), label)
                 p.setPen(QPen(QColor(90, 90, 96), 1))
             f += minor
 

@@ -58,3 +58,16 @@ def test_mit_attachments(shared_data):
     with pytest.raises(FormatError, match="13336 vertices × 16"):
         load_attach(shared_data / "mit6837/Model1.attach", 13336, 17)
     assert summarize(shared_data / "mit6837/Model1.attach")["joints"] == 18
+
+
+@pytest.mark.parametrize("text,fragment,line", [
+    ("", "holds no weights", 1),
+    ("\n  \n", "holds no weights", 1),
+    ("0.5 0.5\n1 0\n0 0 1\n", "this line has 3 weights but the first has 2", 3),
+])
+def test_summary_of_a_broken_file_says_where(tmp_path, text, fragment, line):
+    f = tmp_path / "bad.attach"
+    f.write_text(text)
+    with pytest.raises(FormatError) as info:
+        summarize(f)
+    assert fragment in str(info.value) and info.value.line == line

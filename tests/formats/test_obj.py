@@ -51,6 +51,8 @@ def test_plain_mit_style_and_line_endings():
     ("v 0 0 0\nvt 0 0\nf 1/1 1 1\n", "some corners", 3),
     ("v 0 0 inf\n", "finite", 1),
     ("v 0 0 0\nf 1/1/1/1 1 1\n", "face corner", 2),
+    ("", "no vertices", 1),
+    ("# only a comment\nhello world\n", "no vertices", 1),
 ])
 def test_errors(text, fragment, line):
     with pytest.raises(FormatError) as info:

@@ -60,8 +60,61 @@ def test_errors_are_one_line(qapp, tmp_path: Path, capsys, args: list[str], mess
 
 
 def test_view_3d_renders_or_says_why(qapp, tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
-    rc = render_main([str(SCENES / "pendulum_clock.svg"), "-o", str(tmp_path / "f"), "--frames", "0:1",
+    rc = render_main([str(SCENES / "arm3d" / "arm3d.qtanim"), "-o", str(tmp_path / "f"), "--frames", "0:1",
                       "--size", "64x48", "--view", "3d", "--quiet"])
     if rc != 0:
         err = capsys.readouterr().err.strip().splitlines()
         assert len(err) == 1
+    else:
+        assert sorted(p.name for p in (tmp_path / "f").iterdir()) == ["frame_0000.png", "frame_0001.png"]
+
+
+@pytest.mark.parametrize("scene,view,message", [
+    ("pendulum_clock.svg", "3d", "no 3D characters"),
+    ("arm3d/arm3d.qtanim", "2d", "no 2D characters"),
+])
+def test_a_view_that_would_show_nothing_is_refused(qapp, tmp_path: Path, capsys, scene: str, view: str,  # type: ignore[no-untyped-def]
+                                                   message: str) -> None:
+    out = tmp_path / "f"
+    assert render_main([str(SCENES / scene), "-o", str(out), "--frames", "0:1", "--view", view, "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and message in err[0]
+    assert not out.exists()
+
+
+def test_the_default_view_follows_the_scene() -> None:
+    from qtanimator.document import open_document
+    from qtanimator.render.cli_render import choose_view, load_scene
+
+    assert choose_view(load_scene(SCENES / "pendulum_clock.svg"), "auto") == "2d"
+    assert choose_view(open_document(SCENES / "arm3d" / "arm3d.qtanim"), "auto") == "3d"
+    assert choose_view(open_document(SCENES / "cloth" / "cloth.qtanim"), "auto") == "3d"
+
+
+def test_negative_frames_and_broken_patterns(qapp, tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    out = tmp_path / "neg"
+    assert render_main([str(SCENES / "pendulum_clock.svg"), "-o", str(out / "f_%03d.png"), "--frames", "-2:0",
+                        "--size", "40x40", "--quiet"]) == 0
+    assert sorted(p.name for p in out.iterdir()) == ["f_-01.png", "f_-02.png", "f_000.png"]
+    assert render_main([str(SCENES / "pendulum_clock.svg"), "-o", str(tmp_path / "f_%d%d.png"), "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "not a frame pattern" in err[0]
+
+
+@pytest.mark.parametrize("args", [["--frobnicate"], [], ["--view", "4d"]])
+def test_usage_errors_are_one_line(tmp_path: Path, capsys, args: list[str]) -> None:  # type: ignore[no-untyped-def]
+    argv = [str(SCENES / "pendulum_clock.svg"), *args] + ([] if not args else ["-o", str(tmp_path / "x")])
+    with pytest.raises(SystemExit) as exc:
+        render_main(argv)
+    assert exc.value.code == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("qtanimator render:") and "--help" in err[0]
+
+
+def test_an_unwritable_output_is_one_line(qapp, tmp_path: Path, capsys) -> None:  # type: ignore[no-untyped-def]
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    assert render_main([str(SCENES / "pendulum_clock.svg"), "-o", str(blocker / "out.gif"), "--frames", "0:1",
+                        "--quiet"]) == 1
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "cannot write" in err[0] and "Errno" not in err[0]

@@ -31,6 +31,15 @@ def test_output_kinds(tmp_path: Path) -> None:
         output_kind("one.png")
 
 
+@pytest.mark.parametrize("name", ["f_%d%d.png", "f_%%.png", "50%.png", "f_%(n)d.png"])
+def test_a_broken_pattern_is_a_value_error_before_anything_is_written(tmp_path: Path, name: str) -> None:
+    with pytest.raises(ValueError, match="pattern|same name"):
+        output_kind(tmp_path / name)
+    with pytest.raises(ValueError):
+        write_frames(frames(2), tmp_path / "seq" / name, 24)
+    assert not (tmp_path / "seq").exists()
+
+
 def test_png_folder_and_pattern(tmp_path: Path) -> None:
     seen: list[int] = []
     assert write_frames(frames(4, alpha=True), tmp_path / "out", 24, progress=seen.append) == 4

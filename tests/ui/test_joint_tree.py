@@ -164,3 +164,8 @@ def test_3d_skeleton_joints_and_dof_limits(qtbot, shared_data):
     posed = c3d.pose_skeleton(window.doc, aid, 0.0)
     assert posed.joints[1].dofs["xyz".index(row.spec.label[-1])].value == pytest.approx(
         math.radians(row.spin.maximum()), abs=1e-6)
+    # The skeleton's own row moves its root.
+    window.ctx.select(aid, "")
+    assert [r.spec.label for r in panel.dofs.rows] == ["translate x", "translate y", "translate z"]
+    panel.dofs.rows[1].spin.setValue(0.5)
+    assert c3d.pose_skeleton(window.doc, aid, 0.0).root_translation[1] == pytest.approx(0.5)
