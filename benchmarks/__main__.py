@@ -23,6 +23,11 @@ Convention for benchmark modules (``benchmarks/bench_<name>.py``)
 ``NAME`` selects modules by the part after ``bench_`` (``channel``, ``startup``, …); with no
 name every module runs. A module that fails prints one row with the error and the runner
 goes on; the exit status is 1 if any module failed. ``--json`` prints the rows as JSON.
+
+When more than one module runs, each runs in a fresh Python process: a module's
+process-wide state (a QApplication on the ``offscreen`` platform, which can make no OpenGL
+context; numba or warp caches; imported peers) must not change another module's figures.
+Whatever a module prints on stdout goes to stderr, so the table stays clean.
 """
 
 from __future__ import annotations
@@ -30,7 +35,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import json
+import subprocess
 import sys
+import tempfile
 import time
 import traceback
 from pathlib import Path
@@ -61,6 +68,20 @@ def run_module(name: str) -> tuple[list[dict[str, Any]], bool]:
     except Exception as exc:  # keep going: one broken benchmark must not hide the others
         traceback.print_exc(file=sys.stderr)
         return [{"name": f"{name}: failed", "module": name, "skipped": f"{type(exc).__name__}: {exc}"}], False
+
+
+def run_module_isolated(name: str) -> tuple[list[dict[str, Any]], bool]:
+    """:func:`run_module` in a fresh Python process (rows come back through a file)."""
+    with tempfile.TemporaryDirectory(prefix="qtanimator-bench-") as tmp:
+        rows_file = Path(tmp) / "rows.json"
+        proc = subprocess.run([sys.executable, "-m", "benchmarks", name, "--rows-to", str(rows_file)],
+                              cwd=HERE.parent, stdout=sys.stderr, check=False)
+        try:
+            rows = json.loads(rows_file.read_text())
+        except (OSError, ValueError):
+            return [{"name": f"{name}: failed", "module": name,
+                     "skipped": f"the benchmark process ended with status {proc.returncode} and no rows"}], False
+        return rows, proc.returncode == 0
 
 
 def _cell(value: Any) -> str:
@@ -98,6 +119,7 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__.split("\n")[0])
     parser.add_argument("names", nargs="*", help=f"modules to run (default: all of {', '.join(discover())})")
     parser.add_argument("--json", action="store_true", help="print the rows as JSON instead of a table")
+    parser.add_argument("--rows-to", help=argparse.SUPPRESS)  # used by the runner's child processes
     ns = parser.parse_args(argv)
     available = discover()
     unknown = [n for n in ns.names if n not in available]
@@ -107,12 +129,17 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     rows: list[dict[str, Any]] = []
     ok = True
-    for name in ns.names or available:
+    names = ns.names or available
+    for name in names:
         start = time.perf_counter()
-        module_rows, fine = run_module(name)
+        module_rows, fine = run_module_isolated(name) if len(names) > 1 else run_module(name)
         ok &= fine
         rows.extend(module_rows)
-        print(f"[{name}: {time.perf_counter() - start:.1f} s]", file=sys.stderr)
+        if not ns.rows_to:  # a child process: the parent prints the time
+            print(f"[{name}: {time.perf_counter() - start:.1f} s]", file=sys.stderr)
+    if ns.rows_to:
+        Path(ns.rows_to).write_text(json.dumps(rows, default=str))
+        return 0 if ok else 1
     if ns.json:
         print(json.dumps(rows, indent=2, default=str))
     else:

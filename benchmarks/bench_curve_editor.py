@@ -71,15 +71,15 @@ def run() -> list[dict[str, Any]]:
     rows = [
         {"name": f"curve editor: redraw after dragging one key ({visible} wasp channels visible)",
          "figure": round(ours, 3), "unit": "ms", "peer figure": round(peer, 3),
-         "ratio": round(ours / peer, 3), "goal": f"< {GOAL_MS:g} ms",
+         "ratio": round(peer / ours, 3), "goal": f"< {GOAL_MS:g} ms",
          "peer": "same drag, every channel resampled and redrawn"},
         {"name": "curve editor: 90th percentile of the drag's redraws", "figure": round(_p90(warm), 3),
-         "unit": "ms", "peer figure": round(_p90(cold), 3), "ratio": round(_p90(warm) / _p90(cold), 3),
+         "unit": "ms", "peer figure": round(_p90(cold), 3), "ratio": round(_p90(cold) / _p90(warm), 3),
          "goal": f"< {GOAL_MS:g} ms"},
         {"name": "curve editor: CPU time per redraw after dragging one key (less sensitive to a busy machine)",
          "figure": round(statistics.median(warm_cpu), 3), "unit": "ms CPU",
          "peer figure": round(statistics.median(cold_cpu), 3),
-         "ratio": round(statistics.median(warm_cpu) / statistics.median(cold_cpu), 3), "goal": f"< {GOAL_MS:g} ms"},
+         "ratio": round(statistics.median(cold_cpu) / statistics.median(warm_cpu), 3), "goal": f"< {GOAL_MS:g} ms"},
     ]
     editor.close()
     editor.deleteLater()

@@ -44,7 +44,8 @@ def _row(name: str, ours: float | None, peer: float | None, goal: str, peer_name
     row: dict[str, Any] = {
         "name": name, "figure": None if ours is None else round(ours, 3), "unit": unit,
         "peer figure": None if peer is None else round(peer, 3),
-        "ratio": None if ours is None or peer is None else round(ours / peer, 4),
+        # the runner's convention for times: peer / ours, so that above 1 means we are faster
+        "ratio": None if ours is None or peer is None or ours == 0 else round(peer / ours, 4),
         "goal": goal, "peer": peer_name,
     }
     if met is not None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 import os
 import re
+import stat
 from pathlib import Path
 from typing import NoReturn
 
@@ -28,17 +29,36 @@ _COMMENT = re.compile(r"#|//")
 MAX_BYTES = 512 * 1024 * 1024
 
 
+def read_bytes(path: str | os.PathLike[str], max_bytes: int = MAX_BYTES) -> bytes:
+    """The bytes of a regular file; FormatError for folders, devices, pipes, unreadable or huge files.
+
+    Reading ``/dev/zero`` or a named pipe would never end, so only regular files are read,
+    and never more than ``max_bytes``.
+    """
+    p = Path(path)
+    try:
+        mode = p.stat().st_mode
+        if stat.S_ISDIR(mode):
+            raise FormatError("cannot read the file: it is a folder.", p)
+        if not stat.S_ISREG(mode):
+            raise FormatError("cannot read the file: it is a device or a pipe, not a regular file.", p)
+        if p.stat().st_size > max_bytes:
+            raise FormatError("the file is too large to be a model or animation file.", p)
+        with p.open("rb") as fh:
+            raw = fh.read(max_bytes + 1)
+    except FormatError:
+        raise
+    except (OSError, ValueError) as exc:  # ValueError: a NUL byte in the path
+        raise FormatError(f"cannot read the file ({getattr(exc, 'strerror', None) or exc}).", p) from exc
+    if len(raw) > max_bytes:
+        raise FormatError("the file is too large to be a model or animation file.", p)
+    return raw
+
+
 def read_text(path: str | os.PathLike[str]) -> str:
     """The file's text, or FormatError for unreadable, binary or non-UTF-8 files."""
     p = Path(path)
-    try:
-        if p.is_dir():
-            raise FormatError("this is a folder, not a file.", p)
-        if p.stat().st_size > MAX_BYTES:
-            raise FormatError("the file is too large to be a model or animation file.", p)
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise FormatError(f"cannot read the file ({exc.strerror or exc}).", p) from exc
+    raw = read_bytes(p)
     if b"\0" in raw:
         raise FormatError("the file contains binary data, not text.", p)
     try:

@@ -36,5 +36,14 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
         raise
 
 
+def mode_for(path: str | os.PathLike[str]) -> int:
+    """The permission bits a new version of ``path`` should get: the old file's, or the
+    mode a plain ``open()`` would give under the umask."""
+    try:
+        return os.stat(path).st_mode & 0o7777
+    except OSError:
+        return 0o666 & ~_UMASK
+
+
 def write_text_atomic(path: str | os.PathLike[str], text: str) -> None:
     write_atomic(path, text.encode("utf-8"))

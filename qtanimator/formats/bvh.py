@@ -36,6 +36,7 @@ import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key, Tangent
 from qtanimator.core.skeleton import Joint, Skeleton
+from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.errors import FormatError
 
 FloatArray = npt.NDArray[np.float64]
@@ -589,11 +590,7 @@ def parse_bvh(text: str, path: str | os.PathLike[str] | None = None) -> BvhClip:
 
 def load_bvh(path: str | os.PathLike[str]) -> BvhClip:
     """Read a ``.bvh`` file. Raises :class:`FormatError` (never anything else) on bad input."""
-    try:
-        data = Path(path).read_bytes()
-    except OSError as exc:
-        raise FormatError(f"cannot read the file: {exc.strerror or exc}.", path) from exc
-    return parse_bvh(_decode(data), path)
+    return parse_bvh(_decode(read_bytes(path)), path)
 
 
 def summarize(path: Path) -> dict[str, Any]:

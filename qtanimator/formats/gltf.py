@@ -41,6 +41,7 @@ import numpy.typing as npt
 from qtanimator.core.channel import Channel
 from qtanimator.core.skeleton import ROTATION_ORDERS, Skeleton
 from qtanimator.core.skinning import Skin, SkinBinding
+from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.atomic import write_atomic
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.glb import build_glb, is_glb, parse_json_text, read_glb
@@ -649,15 +650,15 @@ def _read_uri(uri: str, base: Path | None, where: str, path: str | None) -> byte
         except (binascii.Error, ValueError) as exc:
             raise FormatError(f"{where}.uri holds invalid base64 data.", path) from exc
     if base is None:
-        raise FormatError(f"{where} refers to an external file '{_short(uri)}' but the glTF has no folder.", path)
+        raise FormatError(f"{where} refers to an external file {_short(uri)} but the glTF has no folder.", path)
     parsed = urllib.parse.urlparse(uri)
     if parsed.scheme and len(parsed.scheme) > 1:
-        raise FormatError(f"{where}.uri '{_short(uri)}' is not a local file.", path)
+        raise FormatError(f"{where}.uri {_short(uri)} is not a local file.", path)
     target = base / urllib.parse.unquote(uri)
     try:
-        return target.read_bytes()
-    except (OSError, ValueError) as exc:
-        raise FormatError(f"{where} refers to '{_short(uri)}', which cannot be read.", path) from exc
+        return read_bytes(target)
+    except (OSError, ValueError) as exc:  # FormatError too: a folder, a device, a missing file
+        raise FormatError(f"{where} refers to {_short(uri)}, which cannot be read.", path) from exc
 
 
 def import_gltf(path: str | os.PathLike[str]) -> GltfScene:
@@ -666,11 +667,7 @@ def import_gltf(path: str | os.PathLike[str]) -> GltfScene:
     Raises :class:`FormatError` and nothing else on bad input.
     """
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except OSError as exc:
-        raise FormatError(f"cannot read the file: {exc.strerror or exc}.", path) from exc
-    return parse_gltf(data, path, base=p.parent)
+    return parse_gltf(read_bytes(p), path, base=p.parent)
 
 
 def parse_gltf(data: bytes, path: str | os.PathLike[str] | None = None, base: Path | None = None) -> GltfScene:

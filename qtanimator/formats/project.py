@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import Any
 
 from qtanimator.core.channel import Channel
+from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.atomic import write_text_atomic
 from qtanimator.formats.errors import FormatError
 
@@ -96,10 +97,7 @@ def save_project(data: Any, path: str | os.PathLike[str]) -> None:
 def load_project(path: str | os.PathLike[str]) -> ProjectData:
     """Read a project file. Raises FormatError, never anything else, on bad input."""
     p = Path(path)
-    try:
-        raw = p.read_bytes()
-    except OSError as exc:
-        raise FormatError(f"cannot read the file ({exc.strerror or exc}).", p) from exc
+    raw = read_bytes(p)
     try:
         text = raw.decode("utf-8")
     except UnicodeDecodeError as exc:

@@ -26,6 +26,7 @@ import numpy as np
 import svgelements as se
 
 from qtanimator.core.rig2d import RGBA, Character, Joint, Shape
+from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.errors import FormatError
 
 log = logging.getLogger(__name__)
@@ -51,10 +52,7 @@ def load_characters(path: str | os.PathLike[str]) -> list[Character]:
 def load_character(path: str | os.PathLike[str], name: str | None = None) -> Character:
     """One character from one SVG file."""
     p = Path(path)
-    try:
-        data = p.read_bytes()
-    except OSError as exc:
-        raise FormatError(f"cannot read the file ({exc.strerror or exc}).", p) from None
+    data = read_bytes(p, _MAX_FILE_BYTES)
     return parse_character(data, name or p.stem, p)
 
 
@@ -87,8 +85,10 @@ def parse_character(data: bytes, name: str, path: str | os.PathLike[str] | None 
                               "must be a group <g> of joints.", path)
         builder.joint(first, None)
         joints = builder.joints
-        character = Character(name, joints, source=None if path is None else str(path),
-                              warnings=builder.warnings)
+        with np.errstate(all="ignore"):  # huge coordinates are reported below, not warned about
+            character = Character(name, joints, source=None if path is None else str(path),
+                                  warnings=builder.warnings)
+        _check_finite(character, path)
     except FormatError:
         raise
     except RecursionError:
@@ -99,6 +99,23 @@ def parse_character(data: bytes, name: str, path: str | os.PathLike[str] | None 
     for w in builder.warnings:
         log.warning("%s: %s", os.path.basename(os.fspath(path)) if path else name, w)
     return character
+
+
+def _check_finite(character: Character, path: str | os.PathLike[str] | None) -> None:
+    """FormatError when a joint's geometry or mass properties are not finite numbers.
+
+    Coordinates near the float limit (``1e308``) parse, but their areas and moments overflow;
+    a pendulum built on them would only produce NaN later, far from the cause.
+    """
+    for i, j in enumerate(character.joints):
+        values = [np.asarray(j.pivot, dtype=np.float64).ravel()]
+        values += [np.asarray(sh.points, dtype=np.float64).ravel() for sh in j.shapes]
+        for mp in (j.mass_properties, j.reference_mass_properties):
+            if mp is not None:
+                values.append(np.array([mp.mass, mp.inertia, *np.ravel(mp.centroid)], dtype=np.float64))
+        if not all(np.isfinite(v).all() for v in values):
+            raise FormatError(f"joint {i} ('{j.name}') has coordinates too large (or not numbers), so its "
+                              "size, mass or pivot cannot be computed.", path)
 
 
 def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:

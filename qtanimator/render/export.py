@@ -12,12 +12,18 @@ the 3D viewport and the GUI export dialog all share it. Formats by ``out``:
 
 from __future__ import annotations
 
+import contextlib
+import io
 import os
+import tempfile
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+
+from qtanimator.formats.atomic import mode_for, write_atomic
 
 VIDEO_SUFFIXES = {".mp4": "libx264", ".mov": "libx264", ".mkv": "libx264", ".avi": "mpeg4",
                   ".webm": "libvpx-vp9"}
@@ -128,14 +134,21 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
             if progress is not None:
                 progress(count)
         if images:
-            images[0].save(path, save_all=True, append_images=images[1:], loop=0,
+            buffer = io.BytesIO()
+            images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:], loop=0,
                            duration=max(int(round(1000.0 / fps)), 10), optimize=False)
+            write_atomic(path, buffer.getvalue())  # a failed export leaves the old file intact
         return count
     import imageio.v2 as iio2
 
     codec = VIDEO_SUFFIXES[Path(path).suffix.lower()]
+    # ffmpeg writes a temporary file beside the target (same suffix: it picks the container
+    # from it), which replaces the target only once the video is complete.
+    fd, tmp = tempfile.mkstemp(prefix=f".{Path(path).name}.", suffix=Path(path).suffix, dir=parent)
+    os.close(fd)
     writer = None
     shape = None
+    done = False
     try:
         for frame in frames:
             if cancel is not None and cancel():
@@ -143,17 +156,31 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
             a = _check_frame(frame, shape)
             shape = a.shape
             if writer is None:
-                writer = iio2.get_writer(path, format="FFMPEG", mode="I", fps=float(fps), codec=codec,
+                writer = iio2.get_writer(tmp, format="FFMPEG", mode="I", fps=float(fps), codec=codec,
                                          macro_block_size=1, quality=8, pixelformat="yuv420p",
                                          output_params=["-movflags", "+faststart"] if codec == "libx264" else None)
             writer.append_data(_even(flatten_alpha(a)))
             count += 1
             if progress is not None:
                 progress(count)
+        if writer is not None:
+            writer.close()
+            writer = None
+            _replace_keeping_mode(tmp, path)
+            done = True
     finally:
         if writer is not None:
             writer.close()
+        if not done:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
     return count
+
+
+def _replace_keeping_mode(tmp: str, target: str) -> None:
+    """``os.replace`` with the old file's mode, or the mode a plain ``open`` would give."""
+    os.chmod(tmp, mode_for(target))
+    os.replace(tmp, target)
 
 
 def count_video_frames(path: str | os.PathLike[str]) -> int:
@@ -166,7 +193,7 @@ def count_video_frames(path: str | os.PathLike[str]) -> int:
             return int(getattr(im, "n_frames", 1))
     import imageio.v2 as iio2
 
-    reader = iio2.get_reader(p, format="FFMPEG")
+    reader: Any = iio2.get_reader(p, format="FFMPEG")  # imageio's stubs call it an Array
     try:
         n = 0
         for _ in reader:

@@ -141,6 +141,10 @@ class ClothPanel(QWidget):
         s.setSingleStep(step)
         s.setDecimals(decimals)
         s.setObjectName(f"cloth_{name}")
+        # A typed value is one edit, committed with Enter or on leaving the field (not one
+        # command and one re-simulation per keystroke); the arrows still apply at once.
+        s.setKeyboardTracking(False)
+        s.editingFinished.connect(self.end_gesture)
         return s
 
     def _make_editor(self, name: str, parent: QWidget) -> QWidget:
@@ -153,6 +157,8 @@ class ClothPanel(QWidget):
             i = QSpinBox(parent)
             i.setObjectName(f"cloth_{name}")
             i.setRange(*INT_RANGES[name])
+            i.setKeyboardTracking(False)
+            i.editingFinished.connect(self.end_gesture)
             i.valueChanged.connect(lambda v, n=name: self.edit(n, int(v)))
             self.editors[name] = i
             return i
@@ -233,7 +239,13 @@ class ClothPanel(QWidget):
         self.ctx.push(cmd)
         return True
 
+    def end_gesture(self) -> None:
+        """The next edit is a new undo step (a field lost the focus or Enter was pressed)."""
+        self._gesture = None
+
     def _vector_edited(self, name: str) -> None:
+        if self._updating:
+            return
         self.edit(name, [float(s.value()) for s in self.editors[name]])
         if name == "wind":
             self._show_speed()
@@ -249,9 +261,12 @@ class ClothPanel(QWidget):
 
     def _show_speed(self) -> None:
         v = [float(s.value()) for s in self.editors["wind"]]
-        self._updating = True
-        self.wind_speed.setValue(math.sqrt(sum(c * c for c in v)))
-        self._updating = False
+        # Keep the caller's flag: refresh_fields calls this while it fills the other fields.
+        updating, self._updating = self._updating, True
+        try:
+            self.wind_speed.setValue(math.sqrt(sum(c * c for c in v)))
+        finally:
+            self._updating = updating
 
     def _sphere_edited(self) -> None:
         on, spins = self.editors["spheres"]
@@ -271,7 +286,7 @@ class ClothPanel(QWidget):
         self.edit("custom_pins", pins)
 
     def _on_asset_changed(self, _index: int) -> None:
-        self._gesture = None
+        self.end_gesture()
         self.refresh_fields()
 
     def add_cloth(self) -> None:

@@ -292,11 +292,32 @@ def _make_actions(window: MainWindow, playback: Playback, control: TimelineContr
         a.triggered.connect(lambda _checked=False: slot())  # type: ignore[operator]
         return a
 
+    def other_player() -> object | None:
+        """The 3D viewport's clip controls when they are the ones playing."""
+        panel = getattr(window, "viewport_panel", None)
+        controls = getattr(panel, "controls", None)
+        return controls if getattr(controls, "playing", False) else None
+
+    def play_pause() -> None:
+        # The Play button shows "Pause" while any player plays (ctx.playingChanged), so
+        # Space / Play must pause the 3D clip controls too, not start the timeline over them.
+        clip = other_player()
+        if clip is not None:
+            clip.set_playing(False)  # type: ignore[attr-defined]
+        else:
+            playback.toggle()
+
+    def stop() -> None:
+        clip = other_player()
+        if clip is not None:
+            clip.set_playing(False)  # type: ignore[attr-defined]
+        playback.stop()
+
     sp = QStyle.StandardPixmap
     actions = {
-        "actionPlay": action("actionPlay", "Play / Pause", playback.toggle, ["Space"], sp.SP_MediaPlay,
+        "actionPlay": action("actionPlay", "Play / Pause", play_pause, ["Space"], sp.SP_MediaPlay,
                              Qt.ShortcutContext.WindowShortcut),
-        "actionStop": action("actionStop", "Stop", playback.stop, [], sp.SP_MediaStop),
+        "actionStop": action("actionStop", "Stop", stop, [], sp.SP_MediaStop),
         "actionRewind": action("actionRewind", "Rewind", control.to_start, ["Home", "Up"], sp.SP_MediaSkipBackward),
         "actionEnd": action("actionEnd", "Go to End", control.to_end, ["End", "Down"], sp.SP_MediaSkipForward),
         "actionStepBack": action("actionStepBack", "Step Back", lambda: control.step(-1), ["Left"],

@@ -53,3 +53,18 @@ def _continues_gesture(stack: QUndoStack, command: Command) -> bool:
         return False
     top = stack.command(stack.index() - 1)
     return isinstance(top, DocumentUndoCommand) and top.command.gesture == command.gesture
+
+
+def drop_gesture(stack: QUndoStack, doc: Document, gesture: object) -> bool:
+    """Take back the step of an aborted drag (Escape) and leave nothing to redo.
+
+    Undoes the top command when it carries ``gesture`` and removes it from the stack.
+    Returns False (and changes nothing) when the top command is another one.
+    """
+    top = stack.command(stack.index() - 1) if stack.index() > 0 else None
+    if not isinstance(top, DocumentUndoCommand) or gesture is None or top.command.gesture != gesture:
+        return False
+    top.command.undo(doc)
+    top.setObsolete(True)
+    stack.undo()  # an obsolete command is removed without being undone again
+    return True

@@ -30,6 +30,7 @@ from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
     QProgressBar,
+    QSizePolicy,
     QSpinBox,
     QToolButton,
     QVBoxLayout,
@@ -139,6 +140,17 @@ def cloth_params(doc: Any, asset_id: str) -> Any:
         return ClothParams.from_dict(data)
     except (TypeError, ValueError):
         return ClothParams()
+
+
+def ik_dofs(skeleton: Any, joint: int, chain_length: int) -> list[tuple[int, int]]:
+    """The DOFs a right-drag on ``joint`` solves over: its ``chain_length`` nearest
+    ancestors without the root; when those have no free DOF (a joint whose only ancestor
+    is the root, like the demo arm's elbow) the root's rotation is used, so the drag moves
+    something instead of nothing."""
+    from qtanimator.core.ik3d import chain_dofs
+
+    dofs = chain_dofs(skeleton, joint, chain_length)
+    return dofs or chain_dofs(skeleton, joint, chain_length, include_root=True)
 
 
 class Viewport3D(QOpenGLWidget):
@@ -440,8 +452,8 @@ class Viewport3D(QOpenGLWidget):
         asset_id, joint, _t = hit
         runtime = self.ctx.doc.runtime.get(asset_id)
         skel = getattr(runtime, "skeleton", None)
-        if skel is None:
-            return False
+        if skel is None or not ik_dofs(skel, joint, self.ik_chain_length):
+            return False   # nothing can move this joint (the root): right-drag zooms
         self.ctx.select(asset_id, self._joint_key(asset_id, joint))
         world = self._pose(asset_id).world_matrices()
         self._drag = {"asset": asset_id, "joint": joint, "anchor": world[joint, :3, 3].copy(),
@@ -463,7 +475,7 @@ class Viewport3D(QOpenGLWidget):
             return
         asset_id, joint = self._drag["asset"], self._drag["joint"]
         skel = self._pose(asset_id)
-        result = solve_ik(skel, joint, target, chain_length=self.ik_chain_length)
+        result = solve_ik(skel, joint, target, dofs=ik_dofs(skel, joint, self.ik_chain_length))
         if not result.values:
             return
         values = {(j, axis): v for (j, axis), v in result.by_axis_name().items()}
@@ -492,7 +504,9 @@ class Viewport3D(QOpenGLWidget):
             self.update()
         elif key == Qt.Key.Key_Escape and self._drag is not None and self._drag.get("mode") == "ik":
             if self._drag.get("pushed"):
-                self.ctx.undo_stack.undo()
+                from qtanimator.ui.undo import drop_gesture
+
+                drop_gesture(self.ctx.undo_stack, self.ctx.doc, self._drag["gesture"])
             self._drag = None
             self.update()
         else:
@@ -657,6 +671,10 @@ class ViewportPanel(QWidget):
         self.weights = QComboBox(self)
         self.weights.setObjectName("viewportWeights")
         self.weights.addItems(["No weights", "All joint weights", "Selected joint weight"])
+        # As wide as the shown choice needs, not as the longest one: the bar fits the
+        # default layout with room for the frame time.
+        self.weights.setSizeAdjustPolicy(QComboBox.SizeAdjustPolicy.AdjustToMinimumContentsLengthWithIcon)
+        self.weights.setMinimumContentsLength(10)
         self.weights.currentIndexChanged.connect(lambda _i: self._on_weights())
         ctx.selectionChanged.connect(lambda _a, _j: self._on_weights())
         self.wireframe = QCheckBox("Wireframe", self)
@@ -679,11 +697,15 @@ class ViewportPanel(QWidget):
         frame.clicked.connect(self.view.frame_selection)
         self.status = QLabel(self)
         self.status.setObjectName("viewportStatus")
+        # The frame time changes every frame: its width must not resize the view (or the
+        # window) while playing. Long error texts are cut here and shown whole as a tooltip.
+        # The label takes the bar's free space (right-aligned) and asks for none.
+        self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
+        self.status.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
         self.view.frameRendered.connect(self._on_frame_rendered)
         for w in (self.show_mode, self.shading, self.weights, self.wireframe, self.grid, self.chain, frame):
             bar.addWidget(w)
-        bar.addStretch(1)
-        bar.addWidget(self.status)
+        bar.addWidget(self.status, 1)
         layout = QVBoxLayout(self)
         layout.setContentsMargins(0, 0, 0, 0)
         layout.setSpacing(0)
@@ -734,6 +756,7 @@ class ViewportPanel(QWidget):
         if self.view.last_error:
             text = f"{self.view.last_error}  ·  {text}"
         self.status.setText(text)
+        self.status.setToolTip(text)
 
 
 def install(window: Any) -> None:

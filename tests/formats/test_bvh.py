@@ -203,6 +203,9 @@ def test_line_endings_and_whitespace(newline: str) -> None:
     (("15 -13 10", "15 x 10"), 25, "'x'"),
     (("Frames: 2", "Frames: 2.5"), 22, "whole number"),
     (("Frames: 2", "Frames: 999999999999"), 25, "ends early"),
+    (("Frames: 2", "Frames: " + "9" * 20), 22, "too large"),
+    (("Frames: 2", "Frames: " + "9" * 5000), 22, "too large"),  # int() refuses > 4300 digits
+    (("CHANNELS 3 Zrotation", "CHANNELS " + "9" * 5000 + " Zrotation"), 9, "too large"),
     (("OFFSET 0 4 0", "OFFSET 0 4"), 13, "number"),
     (("1 2 3 4 5 6\n", "1 2 3 4 5 1e999\n"), 24, "too large"),
     (("Zrotation Xrotation Yrotation\n", "Zrotation Zrotation Yrotation\n"), 9, "twice"),

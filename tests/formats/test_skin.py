@@ -79,6 +79,9 @@ def test_quirks(transform):
     ("triangles 1", "triangle 1", "unknown section"),
     ("\t0 1 2\n", "\t0 1 2.5\n", "whole number"),
     ("positions 3 {", "positions -3 {", "at least 0"),
+    # a whole number too large for numpy's intp must not escape as OverflowError
+    ("\t1 1 1\n", "\t1 18446744073709551616 1\n", "out of range"),
+    ("positions 3 {", "positions " + "9" * 5000 + " {", "whole number"),
 ])
 def test_errors(old, new, fragment):
     with pytest.raises(FormatError) as info:

@@ -127,6 +127,9 @@ def test_duplicate_ids_get_unique_names() -> None:
     (b"<svg><g></g></svg>", "empty group"),
     (b"<svg><g><g><rect width='1' height='1'/><circle r='1'/></g><g/></g></svg>", "empty group"),
     (b"<svg><g><rect width='1' height='1'/><circle r='1'/>", "well-formed"),
+    # areas and moments of such shapes overflow: refused here, not NaN in a pendulum later
+    (b"<svg><g><rect width='1e300' height='1e300'/><circle r='1' fill='white'/></g></svg>", "too large"),
+    (b"<svg><g><path d='M 0 0 L 1e308 3 L 4 1e308 Z'/><circle r='1'/></g></svg>", "too large"),
 ])
 def test_bad_svg_raises_format_error(data: bytes, message: str) -> None:
     with pytest.raises(FormatError, match=message):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from pathlib import Path
 
 import imageio.v3 as iio
@@ -93,3 +94,29 @@ def test_flatten_alpha() -> None:
     a[0, 1] = (0, 0, 0, 0)
     f = flatten_alpha(a)
     assert f.shape == (1, 2, 3) and tuple(f[0, 0]) == (255, 0, 0) and tuple(f[0, 1]) == (255, 255, 255)
+
+
+@pytest.mark.parametrize("name", ["old.gif", "old.mp4"])
+def test_a_failed_export_leaves_the_old_file_and_no_temporary(tmp_path: Path, name: str) -> None:
+    out = tmp_path / name
+    assert write_frames(frames(3), out, 10) == 3
+    out.chmod(0o640)
+    before = out.read_bytes()
+
+    def broken() -> Iterator[np.ndarray]:
+        yield from frames(2)
+        raise RuntimeError("the renderer failed")
+
+    with pytest.raises(RuntimeError):
+        write_frames(broken(), out, 10)
+    assert out.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]
+    # a good export replaces it, keeping its permissions
+    assert write_frames(frames(5), out, 10) == 5
+    assert count_video_frames(out) == 5 and (out.stat().st_mode & 0o777) == 0o640
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]
+
+
+def test_a_video_cancelled_before_the_first_frame_writes_nothing(tmp_path: Path) -> None:
+    assert write_frames(frames(3), tmp_path / "v.mp4", 10, cancel=lambda: True) == 0
+    assert list(tmp_path.iterdir()) == []

@@ -93,3 +93,43 @@ def test_interactive_pause_and_reset_drive_the_viewport_cloth(qtbot):
     assert view.live.cloths["cloth"].params.gravity == 3.0
     view.set_live_cloth(False)
     assert not live.isChecked()
+
+
+def _type_value(qtbot, spin, text: str) -> None:
+    """Type a value into a spin box as a user does: select, type, Enter."""
+    from PySide6.QtCore import Qt
+
+    spin.setFocus()
+    spin.selectAll()
+    qtbot.keyClicks(spin, text)
+    qtbot.keyClick(spin, Qt.Key.Key_Return)
+
+
+def test_typed_wind_speed_is_one_exact_undo_step_per_edit(qtbot):
+    """Typing a wind speed for a wind that is not along an axis: each typed value is one
+    undo step, and undo gives back exactly the wind before (the panel refreshing its
+    rounded fields must not push commands of its own)."""
+    from qtanimator.document.cloth import set_cloth_param_command
+
+    w = _window(qtbot)
+    w.show()
+    qtbot.waitExposed(w)
+    w.cloth_panel.add_cloth()
+    doc = w.doc
+    w.ctx.push(set_cloth_param_command(doc, "cloth", "wind", [6.0, 0.0, 1.5]))
+    stack = w.ctx.undo_stack
+    start = stack.count()
+    speed = w.findChild(QDoubleSpinBox, "cloth_wind_speed")
+    _type_value(qtbot, speed, "12")
+    assert stack.count() == start + 1
+    wind = cloth_params(doc, "cloth").wind
+    assert sum(c * c for c in wind) ** 0.5 == pytest.approx(12.0, abs=1e-4)
+    assert wind[2] / wind[0] == pytest.approx(0.25, abs=1e-4)    # same direction
+    _type_value(qtbot, speed, "3")
+    assert stack.count() == start + 2                            # a second edit, a second step
+    stack.undo()
+    assert sum(c * c for c in cloth_params(doc, "cloth").wind) ** 0.5 == pytest.approx(12.0, abs=1e-4)
+    stack.undo()
+    assert cloth_params(doc, "cloth").wind == (6.0, 0.0, 1.5)
+    assert speed.value() == pytest.approx(6.18, abs=0.01)
+    assert [s.value() for s in w.cloth_panel.editors["wind"]] == [6.0, 0.0, 1.5]

@@ -184,3 +184,31 @@ def test_stop_button_returns_to_where_playback_began(qtbot):
     rewind = window.findChild(QToolButton, "buttonRewind")
     qtbot.mouseClick(rewind, Qt.MouseButton.LeftButton)
     assert ctx.frame == 0
+
+
+def test_space_and_stop_pause_the_3d_clip_controls_too(qtbot):
+    """While the 3D viewport's clip controls play, the timeline's Play button shows Pause:
+    Space (and the button) must pause them, not start the timeline over them; Stop stops
+    them as well."""
+    from PySide6.QtGui import QAction
+
+    window = make_window(qtbot, full=True)
+    controls = window.viewport_panel.controls
+    play = window.findChild(QAction, "actionPlay")
+    rig = window.findChild(QWidget, "rigEditorView")
+    rig.setFocus()
+    controls.play_button.click()
+    assert controls.playing and play.text() == "Pause"
+    qtbot.waitUntil(lambda: window.ctx.frame > 2)
+    qtbot.keyClick(rig, Qt.Key.Key_Space)
+    assert not controls.playing and not window.playback.playing
+    assert play.text() == "Play" and controls.play_button.text() == "Play"
+    frame = window.ctx.frame
+    qtbot.wait(60)
+    assert window.ctx.frame == frame                      # really paused
+    qtbot.keyClick(rig, Qt.Key.Key_Space)                 # Space again plays the timeline
+    assert window.playback.playing and not controls.playing
+    window.playback.pause()
+    controls.play_button.click()
+    window.findChild(QAction, "actionStop").trigger()
+    assert not controls.playing and not window.playback.playing

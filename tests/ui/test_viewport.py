@@ -303,6 +303,8 @@ def test_f_frames_the_selection_and_escape_cancels_an_ik_drag(window, qtbot, sha
     qtbot.keyClick(view, Qt.Key.Key_Escape)
     qtbot.mouseRelease(view, Qt.MouseButton.RightButton, pos=a + QPoint(0, -20))
     np.testing.assert_allclose(pose_skeleton(window.doc, "mit", 0.0).world_matrices()[14, :3, 3], p0, atol=1e-9)
+    # Escape leaves neither an undo step nor a redo step behind
+    assert window.ctx.undo_stack.count() == steps and not window.ctx.undo_stack.canRedo()
 
 
 def test_an_asset_that_cannot_be_drawn_is_reported_and_the_rest_still_draws(window, qtbot):
@@ -348,3 +350,59 @@ def test_live_cloth_runs_on_the_timer_at_a_fixed_step(window, qtbot):
     qtbot.wait(100)
     assert cloth.time == t
     view.set_live_cloth(False)
+
+
+def test_right_drag_on_a_joint_whose_only_ancestor_is_the_root_turns_the_root(window, qtbot):
+    """The demo arm: shoulder (root) and elbow. Dragging the elbow must move it (the
+    shoulder turns), as one undo step keyed at the current frame; a right-drag on the root
+    itself zooms."""
+    from qtanimator.document.character3d import add_character3d_command, pose_skeleton
+    from qtanimator.paths import scenes_dir
+
+    window.ctx.push(add_character3d_command(window.doc, scenes_dir() / "arm3d" / "arm.skel", asset_id="arm"))
+    view = window.viewport3d
+    view.options.show_skin = False
+    view.camera = OrbitCamera(azimuth=0.0, inclination=0.0, distance=5.0, target=np.array([0.8, 1.4, 0.0]))
+    view._framed_once = True
+    window.ctx.set_frame(20)
+    elbow = pose_skeleton(window.doc, "arm", window.ctx.time).world_matrices()[1]
+    p0 = elbow[:3, 3].copy()
+    w, h = view.width(), view.height()
+    start = view.camera.project(p0, w, h)[0]
+    forearm = view.camera.project((elbow @ np.array([0.45, 0.0, 0.0, 1.0]))[:3], w, h)[0]
+    a = QPoint(int(round(forearm[0])), int(round(forearm[1])))    # press on the forearm's box
+    steps = window.ctx.undo_stack.count()
+    qtbot.mousePress(view, Qt.MouseButton.RightButton, pos=a)
+    assert window.ctx.selection == ("arm", "elbow")
+    for k in range(1, 6):
+        qtbot.mouseMove(view, a + QPoint(0, -8 * k))
+    qtbot.mouseRelease(view, Qt.MouseButton.RightButton, pos=a + QPoint(0, -40))
+    assert window.ctx.undo_stack.count() == steps + 1
+    p1 = pose_skeleton(window.doc, "arm", window.ctx.time).world_matrices()[1, :3, 3]
+    assert view.camera.project(p1, w, h)[0][1] < start[1] - 20      # the elbow went up the screen
+    keyed = [c for c in window.doc.channels if c.startswith("arm/shoulder/")]
+    assert keyed and all(any(abs(k.time - window.ctx.time) < 1e-9 for k in window.doc.channels[c].keys)
+                         for c in keyed)
+    window.ctx.undo_stack.undo()
+    np.testing.assert_allclose(pose_skeleton(window.doc, "arm", window.ctx.time).world_matrices()[1, :3, 3], p0,
+                               atol=1e-9)
+    # the root cannot be dragged (nothing above it turns): a right-drag there zooms
+    root = view.camera.project(pose_skeleton(window.doc, "arm", window.ctx.time).world_matrices()[0, :3, 3], w, h)[0]
+    r = QPoint(int(round(root[0])), int(round(root[1])))
+    distance = view.camera.distance
+    qtbot.mousePress(view, Qt.MouseButton.RightButton, pos=r)
+    qtbot.mouseMove(view, r + QPoint(0, 30))
+    qtbot.mouseRelease(view, Qt.MouseButton.RightButton, pos=r + QPoint(0, 30))
+    assert window.ctx.undo_stack.index() == steps and window.ctx.undo_stack.canRedo()
+    assert view.camera.distance != distance
+
+
+def test_status_text_does_not_resize_the_view(window, qtbot):
+    """The frame-time label changes every frame while playing; the GL view keeps its size."""
+    panel = window.viewport_panel
+    qtbot.waitUntil(lambda: panel.status.text() != "")
+    width = panel.view.width()
+    for text in ("1.0 ms", "123.4 ms", "an asset could not be drawn: a long reason " * 3):
+        panel.status.setText(text)
+        qtbot.wait(20)
+        assert panel.view.width() == width
