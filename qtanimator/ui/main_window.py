@@ -1,7 +1,8 @@
 """The main window: menus, dock areas and the central editors over one document.
 
 Each editor lives in its own module with an ``install(window)`` function that adds its
-widgets and actions; :data:`EDITOR_MODULES` lists them in the order they are installed.
+widgets and actions; :data:`EDITOR_MODULES` lists them in the order they are installed
+(tests may install a subset by short name).
 Object names of docks, views and actions are part of the interface (ARCHITECTURE §7).
 """
 
@@ -9,7 +10,7 @@ from __future__ import annotations
 
 import importlib
 import os
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from pathlib import Path
 
 import shiboken6
@@ -63,7 +64,10 @@ def settings() -> QSettings:
 
 
 class MainWindow(QMainWindow):
-    def __init__(self, doc: Document | None = None, install_editors: bool = True) -> None:
+    def __init__(self, doc: Document | None = None,
+                 install_editors: bool | Collection[str] = True) -> None:
+        """``install_editors``: True for every editor, False for the bare shell, or the
+        short names of the editor modules to install (``{"timeline", "rig_editor"}``)."""
         super().__init__()
         self.setObjectName("mainWindow")
         self.ctx = EditorContext(doc, self)
@@ -79,15 +83,10 @@ class MainWindow(QMainWindow):
 
         self._build_menus()
         self._build_undo_history()
-        if install_editors:
-            for name in EDITOR_MODULES:
-                try:
-                    module = importlib.import_module(name)
-                except ModuleNotFoundError as exc:
-                    if exc.name != name:
-                        raise
-                    continue
-                module.install(self)
+        for name in EDITOR_MODULES:
+            short = name.rsplit(".", 1)[1]
+            if install_editors is True or (install_editors and short in install_editors):
+                importlib.import_module(name).install(self)
         # The undo stack is cleared while the window is destroyed: ignore that signal then.
         self.ctx.undo_stack.cleanChanged.connect(
             lambda _clean: shiboken6.isValid(self) and self._update_title())

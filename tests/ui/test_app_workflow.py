@@ -11,7 +11,6 @@ and check the new PNG in.
 
 from __future__ import annotations
 
-import importlib
 import math
 import os
 from pathlib import Path
@@ -23,31 +22,12 @@ from PySide6.QtGui import QImage
 from PySide6.QtWidgets import QGraphicsView
 
 from qtanimator.document import character2d as c2d
-from qtanimator.ui.main_window import EDITOR_MODULES, MainWindow
 from qtanimator.ui.rig_editor import RigEditorView
 from qtanimator.ui.rig_interaction import pick
 
 REFERENCE = Path(__file__).parent / "reference" / "rig_editor_arm.png"
-MINE = ("rig_editor", "timeline", "joint_tree", "properties", "export_dialog", "recovery")
 
 
-def make_window(qtbot, full: bool = False) -> MainWindow:
-    window = MainWindow(install_editors=full)
-    if not full:
-        for name in EDITOR_MODULES:
-            if name.rsplit(".", 1)[1] in MINE:
-                try:
-                    module = importlib.import_module(name)
-                except ModuleNotFoundError:
-                    continue
-                module.install(window)
-    qtbot.addWidget(window)
-    window.resize(1200, 800)
-    window.show()
-    qtbot.waitExposed(window)
-    window.activateWindow()
-    qtbot.waitUntil(window.isActiveWindow)
-    return window
 
 
 def vpos(view, xy) -> QPoint:
@@ -75,8 +55,8 @@ def left_drag(qtbot, view, start: QPoint, end: QPoint) -> None:
     qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, pos=end)
 
 
-def test_pose_keys_save_and_reopen_give_the_same_document(qtbot, shared_data, tmp_path):
-    window = make_window(qtbot, full=True)
+def test_pose_keys_save_and_reopen_give_the_same_document(make_window, qtbot, shared_data, tmp_path):
+    window = make_window(full=True)
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
     view = window.findChild(QGraphicsView, "rigEditorView")
     view.fit_view()
@@ -94,7 +74,7 @@ def test_pose_keys_save_and_reopen_give_the_same_document(qtbot, shared_data, tm
     assert window.save_to(path)
     assert not window.isWindowModified()
 
-    other = make_window(qtbot)
+    other = make_window()
     assert other.open_path(path)
     assert other.doc.state() == state
     for f, world in zip(range(0, 60, 7), poses):
@@ -102,8 +82,8 @@ def test_pose_keys_save_and_reopen_give_the_same_document(qtbot, shared_data, tm
     assert other.rig_editor.view.items_by_asset.keys() == {asset}
 
 
-def test_playback_plays_pendulums_from_the_simulation_cache(qtbot, shared_data):
-    window = make_window(qtbot)
+def test_playback_plays_pendulums_from_the_simulation_cache(make_window, qtbot, shared_data):
+    window = make_window()
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "clock.svg")
     doc = window.doc
     character = doc.runtime["clock"]
@@ -133,8 +113,8 @@ def test_playback_plays_pendulums_from_the_simulation_cache(qtbot, shared_data):
     assert sim.steps_taken == steps
 
 
-def test_open_a_folder_adds_every_character_sorted(qtbot, shared_data):
-    window = make_window(qtbot)
+def test_open_a_folder_adds_every_character_sorted(make_window, qtbot, shared_data):
+    window = make_window()
     folder = shared_data / "cmu-animator" / "scenes" / "testscene"
     assert window.open_path(folder)
     assert len(window.doc.assets) == 6
@@ -161,8 +141,8 @@ def _array(image: QImage) -> np.ndarray:
     return buf.reshape(h, image.bytesPerLine())[:, : w * 4].reshape(h, w, 4)[..., :3].astype(np.int16)
 
 
-def test_image_of_the_editor_matches_the_reference(qtbot, shared_data):
-    window = make_window(qtbot)
+def test_image_of_the_editor_matches_the_reference(make_window, qtbot, shared_data):
+    window = make_window()
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
     asset = next(iter(window.doc.assets))
     doc = window.doc

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
-
 from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import (
@@ -17,28 +15,10 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator.ui.export_dialog import ExportSettings, run_export
-from qtanimator.ui.main_window import EDITOR_MODULES, MainWindow
-
-MINE = ("rig_editor", "timeline", "joint_tree", "properties", "export_dialog", "recovery")
 
 
-def make_window(qtbot) -> MainWindow:
-    window = MainWindow(install_editors=False)
-    for name in EDITOR_MODULES:
-        if name.rsplit(".", 1)[1] in MINE:
-            try:
-                module = importlib.import_module(name)
-            except ModuleNotFoundError:
-                continue
-            module.install(window)
-    qtbot.addWidget(window)
-    window.show()
-    qtbot.waitExposed(window)
-    return window
-
-
-def test_export_dialog_writes_a_png_sequence(qtbot, shared_data, tmp_path):
-    window = make_window(qtbot)
+def test_export_dialog_writes_a_png_sequence(make_window, qtbot, shared_data, tmp_path):
+    window = make_window(size=None, active=False)
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
     out = tmp_path / "frames"
     done: list[bool] = []
@@ -78,8 +58,8 @@ def _left():
     return Qt.MouseButton.LeftButton
 
 
-def test_gif_export_and_cancel(qtbot, shared_data, tmp_path):
-    window = make_window(qtbot)
+def test_gif_export_and_cancel(make_window, qtbot, shared_data, tmp_path):
+    window = make_window(size=None, active=False)
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
     from qtanimator.core.channel import Key
     from qtanimator.document.commands import SetKeys

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
 import math
 
 import pytest
@@ -10,32 +9,11 @@ from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QDockWidget, QDoubleSpinBox, QSlider, QStyle, QStyleOptionSlider
 
 from qtanimator.document import character2d as c2d
-from qtanimator.ui.main_window import EDITOR_MODULES, MainWindow
-
-MINE = ("rig_editor", "timeline", "joint_tree", "properties", "export_dialog", "recovery")
-
-
-def make_window(qtbot) -> MainWindow:
-    window = MainWindow(install_editors=False)
-    for name in EDITOR_MODULES:
-        if name.rsplit(".", 1)[1] in MINE:
-            try:
-                module = importlib.import_module(name)
-            except ModuleNotFoundError:
-                continue
-            module.install(window)
-    qtbot.addWidget(window)
-    window.resize(1200, 800)
-    window.show()
-    qtbot.waitExposed(window)
-    window.activateWindow()
-    qtbot.waitUntil(window.isActiveWindow)
-    return window
 
 
 @pytest.fixture
-def clock(qtbot, shared_data):
-    window = make_window(qtbot)
+def clock(make_window, qtbot, shared_data):
+    window = make_window()
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "clock.svg")
     window.ctx.undo_stack.clear()
     return window, window.joint_tree
@@ -142,13 +120,13 @@ def test_character_row_moves_and_reset_pose(qtbot, clock):
     assert math.degrees(c2d.joint_angles(doc, "clock", 0.0)[4]) == pytest.approx(45.0)
 
 
-def test_3d_skeleton_joints_and_dof_limits(qtbot, shared_data):
+def test_3d_skeleton_joints_and_dof_limits(make_window, qtbot, shared_data):
     skel = shared_data / "cse169" / "skeleton" / "wasp.skel"
     if not skel.exists():
         pytest.skip("no wasp.skel")
     from qtanimator.document import character3d as c3d
 
-    window = make_window(qtbot)
+    window = make_window()
     window.ctx.push(c3d.add_character3d_command(window.doc, skel))
     aid = next(a for a, v in window.doc.assets.items() if v.kind == c3d.ASSET_KIND)
     panel = window.joint_tree

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
 import math
 
 import numpy as np
@@ -11,31 +10,12 @@ from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtWidgets import QCheckBox, QComboBox, QDockWidget, QDoubleSpinBox, QLabel
 
 from qtanimator.document import character2d as c2d
-from qtanimator.ui.main_window import EDITOR_MODULES, MainWindow
 from qtanimator.ui.rig_interaction import pick
-
-MINE = ("rig_editor", "timeline", "joint_tree", "properties", "export_dialog", "recovery")
-
-
-def make_window(qtbot) -> MainWindow:
-    window = MainWindow(install_editors=False)
-    for name in EDITOR_MODULES:
-        if name.rsplit(".", 1)[1] in MINE:
-            try:
-                module = importlib.import_module(name)
-            except ModuleNotFoundError:
-                continue
-            module.install(window)
-    qtbot.addWidget(window)
-    window.resize(1200, 800)
-    window.show()
-    qtbot.waitExposed(window)
-    return window
 
 
 @pytest.fixture
-def clock(qtbot, shared_data):
-    window = make_window(qtbot)
+def clock(make_window, qtbot, shared_data):
+    window = make_window(active=False)
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "clock.svg")
     window.ctx.undo_stack.clear()
     return window, window.properties_panel
@@ -88,8 +68,8 @@ def test_damping_changes_the_simulation(qtbot, clock):
     assert c2d.evaluate_pose(doc, "clock", 2.0).world_angles[5] == pytest.approx(swing)
 
 
-def test_ik_solver_settings_drive_the_right_drag(qtbot, shared_data):
-    window = make_window(qtbot)
+def test_ik_solver_settings_drive_the_right_drag(make_window, qtbot, shared_data):
+    window = make_window(active=False)
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
     panel = window.properties_panel
     view = window.rig_editor.view

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib
 import math
 
 import numpy as np
@@ -11,35 +10,12 @@ from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtWidgets import QGraphicsView
 
 from qtanimator.document import character2d as c2d
-from qtanimator.ui.main_window import EDITOR_MODULES, MainWindow
 from qtanimator.ui.rig_interaction import pick, rotation_delta
-
-MINE = ("rig_editor", "timeline", "joint_tree", "properties", "export_dialog", "recovery")
-
-
-def make_window(qtbot, full: bool = False) -> MainWindow:
-    """The real main window with this issue's editors (all editors with ``full``)."""
-    window = MainWindow(install_editors=full)
-    if not full:
-        for name in EDITOR_MODULES:
-            if name.rsplit(".", 1)[1] in MINE:
-                try:
-                    module = importlib.import_module(name)
-                except ModuleNotFoundError:
-                    continue
-                module.install(window)
-    qtbot.addWidget(window)
-    window.resize(1200, 800)
-    window.show()
-    qtbot.waitExposed(window)
-    window.activateWindow()
-    qtbot.waitUntil(window.isActiveWindow)
-    return window
 
 
 @pytest.fixture
-def arm(qtbot, shared_data):
-    window = make_window(qtbot)
+def arm(make_window, qtbot, shared_data):
+    window = make_window()
     assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
     view = window.findChild(QGraphicsView, "rigEditorView")
     view.fit_view()

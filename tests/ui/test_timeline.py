@@ -2,36 +2,12 @@
 
 from __future__ import annotations
 
-import importlib
-
 from PySide6.QtCore import QPoint, Qt
 from PySide6.QtWidgets import QDockWidget, QWidget
 
 from qtanimator.core.channel import Key
 from qtanimator.document import InsertKey
-from qtanimator.ui.main_window import EDITOR_MODULES, MainWindow
 from qtanimator.ui.playback import playback_frame
-
-MINE = ("rig_editor", "timeline", "joint_tree", "properties", "export_dialog", "recovery")
-
-
-def make_window(qtbot, full: bool = False) -> MainWindow:
-    """The real main window with this issue's editors (every editor with ``full``)."""
-    window = MainWindow(install_editors=full)
-    if not full:
-        for name in EDITOR_MODULES:
-            if name.rsplit(".", 1)[1] in MINE:
-                try:
-                    module = importlib.import_module(name)
-                except ModuleNotFoundError:
-                    continue
-                module.install(window)
-    qtbot.addWidget(window)
-    window.show()
-    qtbot.waitExposed(window)
-    window.activateWindow()
-    qtbot.waitUntil(window.isActiveWindow)
-    return window
 
 
 def test_playback_frame_follows_the_clock_and_drops_frames():
@@ -44,15 +20,15 @@ def test_playback_frame_follows_the_clock_and_drops_frames():
     assert playback_frame(230, 1.0, 60, 0, 240, loop=True) == ((230 + 60) % 241, True)
 
 
-def test_timeline_dock_and_names(qtbot):
-    window = make_window(qtbot, full=True)
+def test_timeline_dock_and_names(make_window, qtbot):
+    window = make_window(full=True, size=None)
     assert window.findChild(QDockWidget, "timelineDock") is not None
     assert window.findChild(QWidget, "timeline") is not None
     assert window.findChild(type(window.action_save), "actionPlay") is not None
 
 
-def test_keys_step_and_jump(qtbot):
-    window = make_window(qtbot)
+def test_keys_step_and_jump(make_window, qtbot):
+    window = make_window(size=None)
     ctx = window.ctx
     timeline = window.findChild(QWidget, "timeline")
     timeline.setFocus()
@@ -90,8 +66,8 @@ def test_keys_step_and_jump(qtbot):
     assert ctx.frame == 30
 
 
-def test_brackets_change_the_range_undoably(qtbot):
-    window = make_window(qtbot)
+def test_brackets_change_the_range_undoably(make_window, qtbot):
+    window = make_window(size=None)
     timeline = window.findChild(QWidget, "timeline")
     timeline.setFocus()
     qtbot.waitUntil(timeline.hasFocus)
@@ -106,8 +82,8 @@ def test_brackets_change_the_range_undoably(qtbot):
     assert window.doc.frame_range == (0, 240)
 
 
-def test_scrub_by_drag(qtbot):
-    window = make_window(qtbot)
+def test_scrub_by_drag(make_window, qtbot):
+    window = make_window(size=None)
     timeline = window.findChild(QWidget, "timeline")
     y = timeline.height() // 2
     qtbot.mousePress(timeline, Qt.MouseButton.LeftButton, pos=QPoint(int(timeline.frame_to_x(100)), y))
@@ -117,8 +93,8 @@ def test_scrub_by_drag(qtbot):
     assert abs(window.ctx.frame - 150) <= 1
 
 
-def test_playback_advances_frames_and_signals(qtbot):
-    window = make_window(qtbot)
+def test_playback_advances_frames_and_signals(make_window, qtbot):
+    window = make_window(size=None)
     ctx = window.ctx
     states: list[bool] = []
     ctx.playingChanged.connect(states.append)
@@ -138,8 +114,8 @@ def test_playback_advances_frames_and_signals(qtbot):
     assert ctx.frame == paused_at
 
 
-def test_play_without_loop_stops_at_the_end(qtbot):
-    window = make_window(qtbot)
+def test_play_without_loop_stops_at_the_end(make_window, qtbot):
+    window = make_window(size=None)
     ctx = window.ctx
     window.findChild(type(window.action_save), "actionLoop").setChecked(False)
     ctx.set_frame(230)
@@ -148,10 +124,10 @@ def test_play_without_loop_stops_at_the_end(qtbot):
     assert ctx.frame == 240
 
 
-def test_slow_frames_are_dropped_not_slowed_down(qtbot):
+def test_slow_frames_are_dropped_not_slowed_down(make_window, qtbot):
     import time
 
-    window = make_window(qtbot)
+    window = make_window(size=None)
     ctx = window.ctx
     shown: list[float] = []
 
@@ -169,10 +145,10 @@ def test_slow_frames_are_dropped_not_slowed_down(qtbot):
     assert window.playback.dropped_frames > 0
 
 
-def test_stop_button_returns_to_where_playback_began(qtbot):
+def test_stop_button_returns_to_where_playback_began(make_window, qtbot):
     from PySide6.QtWidgets import QToolButton
 
-    window = make_window(qtbot)
+    window = make_window(size=None)
     ctx = window.ctx
     ctx.set_frame(20)
     play = window.findChild(QToolButton, "buttonPlay")
@@ -186,13 +162,13 @@ def test_stop_button_returns_to_where_playback_began(qtbot):
     assert ctx.frame == 0
 
 
-def test_space_and_stop_pause_the_3d_clip_controls_too(qtbot):
+def test_space_and_stop_pause_the_3d_clip_controls_too(make_window, qtbot):
     """While the 3D viewport's clip controls play, the timeline's Play button shows Pause:
     Space (and the button) must pause them, not start the timeline over them; Stop stops
     them as well."""
     from PySide6.QtGui import QAction
 
-    window = make_window(qtbot, full=True)
+    window = make_window(full=True, size=None)
     controls = window.viewport_panel.controls
     play = window.findChild(QAction, "actionPlay")
     rig = window.findChild(QWidget, "rigEditorView")
