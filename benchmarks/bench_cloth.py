@@ -37,6 +37,8 @@ REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
+from benchmarks.common import print_rows  # noqa: E402
+
 DIMS = (32, 64, 128)
 FRAMES = 60
 SUBSTEPS = 16
@@ -243,13 +245,7 @@ def run(dims: tuple[int, ...] = DIMS) -> list[dict[str, Any]]:
 
 
 def main() -> int:
-    rows = run()
-    cols = ["name", "figure", "unit", "peer figure", "ratio", "speedup", "goal", "met"]
-    print(" | ".join(cols))
-    for row in rows:
-        extras = {k: v for k, v in row.items() if k not in cols and k != "peer"}
-        print(" | ".join(str(row.get(c, "")) for c in cols) + (f"  {extras}" if extras else ""))
-    return 0
+    return print_rows(run(), ["name", "figure", "unit", "peer figure", "ratio", "speedup", "goal", "met"])
 
 
 if __name__ == "__main__":

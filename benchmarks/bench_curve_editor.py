@@ -23,6 +23,11 @@ from typing import Any
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 REPO = Path(__file__).resolve().parents[1]
+if str(REPO) not in sys.path:
+    sys.path.insert(0, str(REPO))
+
+from benchmarks.common import print_rows  # noqa: E402
+
 WASP = (REPO / ".." / "shared" / "data" / "cse169" / "wasp_walk").resolve()
 GOAL_MS = 16.0
 MOVES = 40
@@ -130,12 +135,7 @@ def _drag(editor: Any, app: Any, cid: str, index: int, cold: bool) -> tuple[list
 
 
 def main() -> int:
-    rows = run()
-    cols = ["name", "figure", "unit", "peer figure", "ratio", "goal"]
-    print(" | ".join(cols))
-    for row in rows:
-        print(" | ".join(str(row.get(c, "")) for c in cols) + (f"  ({row['skipped']})" if "skipped" in row else ""))
-    return 0
+    return print_rows(run(), ["name", "figure", "unit", "peer figure", "ratio", "goal"])
 
 
 if __name__ == "__main__":

@@ -29,6 +29,9 @@ import numpy as np
 REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
+
+from benchmarks.common import print_rows  # noqa: E402
+
 SAMPLES = (REPO / ".." / "shared" / "data" / "cmu-animator" / "scenes").resolve()
 GOAL_RATIO = 30.0
 GOAL_MS = 1.0
@@ -131,13 +134,7 @@ def run() -> list[dict[str, Any]]:
 
 
 def main() -> int:
-    rows = run()
-    cols = ["name", "figure", "unit", "peer figure", "ratio", "goal", "met"]
-    print(" | ".join(cols))
-    for row in rows:
-        extras = {k: v for k, v in row.items() if k not in cols and k != "peer"}
-        print(" | ".join(str(row.get(c, "")) for c in cols) + (f"  {extras}" if extras else ""))
-    return 0
+    return print_rows(run(), ["name", "figure", "unit", "peer figure", "ratio", "goal", "met"])
 
 
 if __name__ == "__main__":

@@ -31,6 +31,8 @@ REPO = Path(__file__).resolve().parents[1]
 if str(REPO) not in sys.path:
     sys.path.insert(0, str(REPO))
 
+from benchmarks.common import print_rows  # noqa: E402
+
 OWL = (REPO / ".." / "shared" / "data" / "cmu-animator" / "scenes" / "owl.svg").resolve()
 FRAMES = 240
 SIZE = (960, 640)
@@ -133,12 +135,7 @@ def run() -> list[dict[str, Any]]:
 
 
 def main() -> int:
-    rows = run()
-    cols = ["name", "figure", "unit", "peer figure", "ratio", "goal"]
-    print(" | ".join(cols))
-    for row in rows:
-        print(" | ".join(str(row.get(c, "")) for c in cols) + (f"  ({row['skipped']})" if "skipped" in row else ""))
-    return 0
+    return print_rows(run(), ["name", "figure", "unit", "peer figure", "ratio", "goal"])
 
 
 if __name__ == "__main__":

@@ -1,4 +1,4 @@
-"""Helpers shared by the benchmark modules: timing and row building.
+"""Helpers shared by the benchmark modules: timing, row building and standalone printing.
 
 A row is a plain dict; see ``benchmarks/__main__.py`` for the keys the runner prints.
 """
@@ -55,3 +55,13 @@ def skipped(name: str, why: str, unit: str = "", goal: str = "-") -> dict[str, A
     """The row of a benchmark that could not run (a peer not installed, no sample data)."""
     return {"name": name, "figure": None, "unit": unit, "peer figure": None, "ratio": None,
             "goal": goal, "skipped": why}
+
+
+def print_rows(rows: list[dict[str, Any]], columns: list[str]) -> int:
+    """Print ``rows`` as a plain table of ``columns`` (a module run alone, without the
+    runner); keys outside the columns follow each line so nothing measured is hidden."""
+    print(" | ".join(columns))
+    for r in rows:
+        extras = {k: v for k, v in r.items() if k not in columns and k != "peer"}
+        print(" | ".join(str(r.get(c, "")) for c in columns) + (f"  {extras}" if extras else ""))
+    return 0

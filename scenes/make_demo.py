@@ -30,21 +30,26 @@ from qtanimator.document.cloth import add_cloth_command
 HERE = Path(__file__).resolve().parent
 FPS = 60.0
 ROBOT_SHIFT = 1130.0  # Robo's rest hip is at x = 300 in robot.svg; walk it right of the clock
-FLAG_ROWS, FLAG_COLS = 12, 18
+FLAG_ROWS, FLAG_COLS = 16, 24
+FLAG_WIDTH = 1.5
+#: The saved 3D camera: from the front, a little above, the flag on the left, the arm right.
+VIEW3D_CAMERA = {"azimuth": 15.0, "inclination": 10.0, "distance": 4.3,
+                 "target": [-0.95, 1.95, 0.0], "fov_y": 45.0}
 
 
 def flag_params() -> ClothParams:
-    """A 1.2 m × 0.8 m flag whose pinned left edge stands at x = −2.3, left of the arm."""
+    """A light 1.5 m × 1.0 m flag (16 × 24 particles) whose pinned left edge stands at
+    x = −2.9, left of the arm, flying towards +x in a steady breeze with mild gusts."""
     return ClothParams(
-        rows=FLAG_ROWS, cols=FLAG_COLS, width=1.2, height=0.8, total_mass=0.6,
-        structural_stiffness=200.0, structural_damping=0.2,
-        shear_stiffness=80.0, shear_damping=0.1,
-        bend_stiffness=8.0, bend_damping=0.02,
+        rows=FLAG_ROWS, cols=FLAG_COLS, width=FLAG_WIDTH, height=1.0, total_mass=0.35,
+        structural_stiffness=150.0, structural_damping=0.15,
+        shear_stiffness=60.0, shear_damping=0.08,
+        bend_stiffness=4.0, bend_damping=0.02,
         drag_coefficient=1.0, air_density=1.225,
-        wind=(6.0, 0.0, 1.5), turbulence=0.35, turbulence_seed=11,
+        wind=(8.5, 0.0, 0.6), turbulence=0.12, turbulence_seed=11,
         ground_enabled=True, ground_height=0.0,
         pin_mode="custom", custom_pins=pins_from_cells(FLAG_COLS, [(r, 0) for r in range(FLAG_ROWS)]),
-        substeps=16, origin=(-1.7, 2.6, -0.3), orientation=(0.0, 0.0, 0.0),
+        substeps=32, origin=(-2.9 + FLAG_WIDTH / 2, 2.7, -0.3), orientation=(0.0, 0.0, 0.0),
     )
 
 
@@ -90,6 +95,8 @@ def build() -> Document:
     arm = HERE / "arm3d"
     add_character3d_command(doc, arm / "arm.skel", arm / "arm.skin", arm / "arm_wave.anim", asset_id="arm").do(doc)
     add_cloth_command(doc, flag_params(), asset_id="flag").do(doc)
+    # The 3D view opens on the flag and the arm (view state, as the program saves it).
+    doc.parameters["view3d.camera"] = dict(VIEW3D_CAMERA)
     return doc
 
 

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import numpy.typing as npt
 
-from qtanimator.core.skeleton import AXES, Skeleton, rotation_matrices
+from qtanimator.core.skeleton import AXES, Skeleton, axis_rotations
 
 FloatArray = npt.NDArray[np.float64]
 DofRef = tuple[int, int]   # (joint index, axis 0/1/2)
@@ -100,10 +100,8 @@ def jacobian(skeleton: Skeleton, values: npt.ArrayLike, dofs: Sequence[DofRef],
         k = order.index(AXES[a])
         pre = np.eye(3)
         for letter in order[:k]:
-            angles = np.zeros(3)
             i = AXES.index(letter)
-            angles[i] = v[j, i]
-            pre = pre @ rotation_matrices(angles, "xyz")[0]  # one non-zero angle: that axis
+            pre = pre @ axis_rotations(i, v[j, i])[0]
         axis = f[:3, :3] @ pre[:, a]
         jac[:, col] = np.cross(axis, p_end - f[:3, 3])
     return p_end, jac

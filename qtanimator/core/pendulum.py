@@ -206,6 +206,22 @@ class PendulumSystem:
                 out = np.where(inertia > 0, (grav - mass * forcing) / inertia, 0.0)
         return np.asarray(out, dtype=np.float64)
 
+    def _advance_singles(self, th: FloatArray, om: FloatArray, acc: FloatArray,
+                         tau: float) -> tuple[FloatArray, FloatArray]:
+        """One undamped step of the single pendulums with the chosen integrator."""
+        f = self._singles_acceleration
+        method = self.params.integrator
+        if method == "symplectic_euler":
+            om = om + tau * f(th, om, acc)
+            th = th + tau * om
+        elif method == "leapfrog":
+            om = om + 0.5 * tau * f(th, om, acc)
+            th = th + tau * om
+            om = om + 0.5 * tau * f(th, om, acc)
+        else:
+            th, om = _rk4(self._singles_fn(acc), th, om, tau)
+        return th, om
+
     def step(self, theta: FloatArray, omega: FloatArray, pivot_acc: Callable[[int], FloatArray] | FloatArray,
              tau: float | None = None) -> None:
         """Advance the world angles ``theta`` and rates ``omega`` (J,) in place by one step.
@@ -223,18 +239,7 @@ class PendulumSystem:
                 acc = np.array([pivot_acc(int(j)) for j in idx], dtype=np.float64).reshape(-1, 2)
             else:
                 acc = np.asarray(pivot_acc, dtype=np.float64)[idx]
-            th, om = theta[idx], omega[idx]
-            method = self.params.integrator
-            f = self._singles_acceleration
-            if method == "symplectic_euler":
-                om = om + tau * f(th, om, acc)
-                th = th + tau * om
-            elif method == "leapfrog":
-                om = om + 0.5 * tau * f(th, om, acc)
-                th = th + tau * om
-                om = om + 0.5 * tau * f(th, om, acc)
-            else:
-                th, om = _rk4(self._singles_fn(acc), th, om, tau)
+            th, om = self._advance_singles(theta[idx], omega[idx], acc, tau)
             theta[idx] = th
             omega[idx] = om * decay
         for g in self._coupled:
@@ -254,7 +259,6 @@ class PendulumSystem:
         idx = self._singles[0]
         acc = acc_all[idx]
         decay = math.exp(-self.params.damping * tau)
-        f = self._singles_acceleration
         method = self.params.integrator
         traj_t = np.empty((steps, len(theta)))
         traj_w = np.empty((steps, len(theta)))
@@ -263,15 +267,7 @@ class PendulumSystem:
         th, om = theta[idx].copy(), omega[idx].copy()
         for i in range(steps):
             if len(idx):
-                if method == "symplectic_euler":
-                    om = om + tau * f(th, om, acc)
-                    th = th + tau * om
-                elif method == "leapfrog":
-                    om = om + 0.5 * tau * f(th, om, acc)
-                    th = th + tau * om
-                    om = om + 0.5 * tau * f(th, om, acc)
-                else:
-                    th, om = _rk4(self._singles_fn(acc), th, om, tau)
+                th, om = self._advance_singles(th, om, acc, tau)
                 om = om * decay
                 theta[idx], omega[idx] = th, om
             for g in self._coupled:

@@ -122,28 +122,27 @@ def axis_index(axis: str | int) -> int:
     raise ValueError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
 
 
+def axis_rotations(axis: int, angles: npt.ArrayLike) -> FloatArray:
+    """(N, 3, 3) right-handed rotations about x (0), y (1) or z (2) by ``angles`` radians."""
+    a = np.asarray(angles, dtype=np.float64).reshape(-1)
+    c, s = np.cos(a), np.sin(a)
+    r = np.zeros((a.shape[0], 3, 3))
+    i, j = [(1, 2), (2, 0), (0, 1)][axis]
+    r[:, axis, axis] = 1.0
+    r[:, i, i] = c
+    r[:, j, j] = c
+    r[:, i, j] = -s
+    r[:, j, i] = s
+    return r
+
+
 def rotation_matrices(angles: npt.ArrayLike, order: str) -> FloatArray:
     """(N, 3) angles (x, y, z) → (N, 3, 3) rotations, the axis factors multiplied in ``order``."""
     if order not in ROTATION_ORDERS:
         raise ValueError(f"unknown rotation order {order!r}")
     a = np.asarray(angles, dtype=np.float64).reshape(-1, 3)
-    n = a.shape[0]
-    c, s = np.cos(a), np.sin(a)
-    mats = np.zeros((3, n, 3, 3))
-    # Rx
-    mats[0, :, 0, 0] = 1.0
-    mats[0, :, 1, 1], mats[0, :, 1, 2] = c[:, 0], -s[:, 0]
-    mats[0, :, 2, 1], mats[0, :, 2, 2] = s[:, 0], c[:, 0]
-    # Ry
-    mats[1, :, 1, 1] = 1.0
-    mats[1, :, 0, 0], mats[1, :, 0, 2] = c[:, 1], s[:, 1]
-    mats[1, :, 2, 0], mats[1, :, 2, 2] = -s[:, 1], c[:, 1]
-    # Rz
-    mats[2, :, 2, 2] = 1.0
-    mats[2, :, 0, 0], mats[2, :, 0, 1] = c[:, 2], -s[:, 2]
-    mats[2, :, 1, 0], mats[2, :, 1, 1] = s[:, 2], c[:, 2]
     i, j, k = (AXES.index(ch) for ch in order)
-    result: FloatArray = mats[i] @ mats[j] @ mats[k]
+    result: FloatArray = axis_rotations(i, a[:, i]) @ axis_rotations(j, a[:, j]) @ axis_rotations(k, a[:, k])
     return result
 
 

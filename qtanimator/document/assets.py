@@ -28,12 +28,6 @@ def load_runtime(asset: Asset) -> Any:
 
 
 def _ensure_builtin_loaders() -> None:
-    # Engines register themselves on import; importing here keeps start-up lazy.
-    import importlib
-
-    for module in ("qtanimator.document.loaders",):
-        try:
-            importlib.import_module(module)
-        except ModuleNotFoundError as exc:
-            if exc.name != module:
-                raise
+    # Imported on first use: the loaders pull in every engine, which a plain
+    # ``import qtanimator.document`` should not pay for.
+    import qtanimator.document.loaders  # noqa: F401

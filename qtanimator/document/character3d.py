@@ -229,10 +229,13 @@ def add_character3d_command(doc: Document, skel_path: str | os.PathLike[str],
     return AddAsset(asset, runtime, channels, text=f"Add 3D character {aid}")
 
 
-def load_anim_command(doc: Document, asset_id: str, anim_path: str | os.PathLike[str]) -> Command:
-    """Replace the character's DOF channels with an ``.anim`` file's (one undo step)."""
+def load_anim_command(doc: Document, asset_id: str, anim_path: str | os.PathLike[str],
+                      clip: AnimationClip | None = None) -> Command:
+    """Replace the character's DOF channels with an ``.anim`` file's (one undo step);
+    ``clip`` is the file's content when the caller has read it already."""
     ch = character(doc, asset_id)
-    clip = load_anim(anim_path)
+    if clip is None:
+        clip = load_anim(anim_path)
     new = clip_channels(asset_id, ch.skeleton, clip)
     changes: dict[str, tuple[Channel | None, Channel | None]] = {}
     for cid in channel_ids(doc, asset_id):

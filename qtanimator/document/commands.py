@@ -11,7 +11,8 @@ The ``ui`` package wraps each command in a QUndoCommand (``qtanimator.ui.undo``)
 from __future__ import annotations
 
 import math
-from collections.abc import Hashable, Iterable, Sequence
+from collections.abc import Hashable, Iterable, Mapping, Sequence
+from dataclasses import replace
 from typing import Any
 
 from qtanimator.core.channel import Channel, Extrapolation, Key, Tangent
@@ -137,28 +138,40 @@ class DeleteKeys(SetChannels):
         super().__init__(text, changes)
 
 
+def moved_key(key: Key, dt: float, dv: float, time_scale: tuple[float, float] | None = None) -> Key:
+    """``key`` moved by ``(dt, dv)`` or with its time scaled about a pivot, handles kept."""
+    if time_scale is None:
+        return key.moved(key.time + dt, key.value + dv)
+    pivot, factor = time_scale
+    if factor == 0.0:
+        raise ValueError("a time scale factor must not be zero")
+    new = key.moved(pivot + (key.time - pivot) * factor, key.value + dv)
+    # A fixed slope is value per second: stretching time by the factor keeps the handle's
+    # shape only if the slope shrinks by it.
+    in_slope = key.in_slope / factor if key.in_tangent is Tangent.FIXED else key.in_slope
+    out_slope = key.out_slope / factor if key.out_tangent is Tangent.FIXED else key.out_slope
+    return replace(new, in_slope=in_slope, out_slope=out_slope)
+
+
 class MoveKeys(SetChannels):
-    """Move keys by ``(dt, dv)``, keeping each key's rules and slopes.
+    """Move keys by ``(dt, dv)`` (or scale their times about a pivot), keeping each key's
+    rules and span shape.
 
     Built from the channels as they were when the drag began (``base``), so that a drag
-    merged from many mouse moves is exact: the last offset wins. Raises ValueError if a
-    moved key would land on another key's time.
+    merged from many mouse moves is exact: the last offset wins. ``dv`` is one value offset
+    for all channels or a mapping channel id → offset (a drag in the curve editor's
+    normalised view moves each channel by its own amount). Raises ValueError if a moved key
+    would land on another key's time.
     """
 
-    def __init__(self, base: dict[str, Channel], selection: dict[str, Sequence[int]], dt: float,
-                 dv: float, gesture: Hashable | None = None, text: str = "Move Keys",
-                 time_scale: tuple[float, float] | None = None) -> None:
+    def __init__(self, base: Mapping[str, Channel], selection: Mapping[str, Sequence[int]], dt: float,
+                 dv: float | Mapping[str, float] = 0.0, gesture: Hashable | None = None,
+                 text: str = "Move Keys", time_scale: tuple[float, float] | None = None) -> None:
         changes: dict[str, tuple[Channel | None, Channel | None]] = {}
         for cid, idx in selection.items():
             old = base[cid]
-            moved = {}
-            for i in idx:
-                k = old.keys[i]
-                t = k.time + dt
-                if time_scale is not None:
-                    pivot, factor = time_scale
-                    t = pivot + (k.time - pivot) * factor
-                moved[i] = k.moved(t, k.value + dv)
+            offset = dv if isinstance(dv, (int, float)) else float(dv.get(cid, 0.0))
+            moved = {i: moved_key(old.keys[i], dt, float(offset), time_scale) for i in idx}
             changes[cid] = (old, old.replace_keys(moved))
         super().__init__(text, changes, gesture)
 

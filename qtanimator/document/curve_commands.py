@@ -3,57 +3,21 @@
 All of them are :class:`SetChannels` (old and new channel objects), so undo is exact and
 commands of one gesture merge into one undo step.
 
-* :class:`MoveCurveKeys` moves keys by a time offset and a value offset *per channel*
-  (a drag in the normalised view moves each channel by its own amount), or scales their
-  times about a pivot. Every key keeps its rules and span shape; when times are scaled,
-  fixed slopes are divided by the factor so each handle keeps its shape relative to the
-  stretched spans.
+Key moves (a time offset, a value offset per channel, or times scaled about a pivot) are
+:class:`~qtanimator.document.commands.MoveKeys`.
+
 * :class:`SetKeySlopes` sets fixed in / out slopes of one key (a handle drag).
 * :class:`SetKeysBroken` breaks or unifies tangents.
 """
 
 from __future__ import annotations
 
-from collections.abc import Hashable, Iterable, Mapping, Sequence
+from collections.abc import Hashable, Iterable, Mapping
 from dataclasses import replace
 
 from qtanimator.core.channel import Channel, Key, Tangent
 from qtanimator.document.commands import SetChannels
 from qtanimator.document.document import Document
-
-
-def moved_key(key: Key, dt: float, dv: float, time_scale: tuple[float, float] | None = None) -> Key:
-    """``key`` moved by ``(dt, dv)`` or with its time scaled about a pivot, handles kept."""
-    if time_scale is None:
-        return key.moved(key.time + dt, key.value + dv)
-    pivot, factor = time_scale
-    if factor == 0.0:
-        raise ValueError("a time scale factor must not be zero")
-    new = key.moved(pivot + (key.time - pivot) * factor, key.value + dv)
-    in_slope = key.in_slope / factor if key.in_tangent is Tangent.FIXED else key.in_slope
-    out_slope = key.out_slope / factor if key.out_tangent is Tangent.FIXED else key.out_slope
-    return replace(new, in_slope=in_slope, out_slope=out_slope)
-
-
-class MoveCurveKeys(SetChannels):
-    """Move (or scale in time) selected keys of several channels, keeping their handles.
-
-    ``base`` holds the channels as they were when the gesture began, so that every merged
-    step of a drag is computed from the same start and the last offset wins. ``dv`` is one
-    value offset for all channels or a mapping channel id → offset. Raises ValueError if a
-    key would land on another key's time.
-    """
-
-    def __init__(self, base: Mapping[str, Channel], selection: Mapping[str, Sequence[int]], dt: float,
-                 dv: float | Mapping[str, float] = 0.0, gesture: Hashable | None = None,
-                 text: str = "Move Keys", time_scale: tuple[float, float] | None = None) -> None:
-        changes: dict[str, tuple[Channel | None, Channel | None]] = {}
-        for cid, idx in selection.items():
-            old = base[cid]
-            offset = dv if isinstance(dv, (int, float)) else float(dv.get(cid, 0.0))
-            moved = {i: moved_key(old.keys[i], dt, float(offset), time_scale) for i in idx}
-            changes[cid] = (old, old.replace_keys(moved))
-        super().__init__(text, changes, gesture)
 
 
 class SetKeySlopes(SetChannels):

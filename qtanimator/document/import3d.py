@@ -258,8 +258,9 @@ def anim_import(doc: Document, path: str | os.PathLike[str], selected: str | Non
         why = "there is no 3D character to animate" if have == 0 else f"there are {have} 3D characters"
         raise FormatError(f"an .anim file animates the selected 3D character, and {why}: open or select "
                           "a skeleton first.", p)
-    cmd = load_anim_command(doc, target, p)
-    return _with_range(doc, cmd.text, cmd, load_anim(p).end, target, [f"Applied to {target}."])
+    clip = load_anim(p)
+    cmd = load_anim_command(doc, target, p, clip)
+    return _with_range(doc, cmd.text, cmd, clip.end, target, [f"Applied to {target}."])
 
 
 # ---------------------------------------------------------------------------- BVH

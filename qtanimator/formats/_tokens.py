@@ -138,7 +138,7 @@ class Tokens:
                               self.path, self.line())
         tok = self.toks[self.pos]
         if tok != word:
-            self.error(f"expected '{word}'{where}, found '{_show(tok)}'.")
+            self.error(f"expected '{word}'{where}, found '{show(tok)}'.")
         self.pos += 1
 
     def accept(self, word: str) -> bool:
@@ -153,9 +153,9 @@ class Tokens:
         try:
             v = float(tok)
         except ValueError:
-            self.error(f"expected a number for {what}, found '{_show(tok)}'.", self.pos - 1)
+            self.error(f"expected a number for {what}, found '{show(tok)}'.", self.pos - 1)
         if not math.isfinite(v):
-            self.error(f"{what} must be a finite number, found '{_show(tok)}'.", self.pos - 1)
+            self.error(f"{what} must be a finite number, found '{show(tok)}'.", self.pos - 1)
         return v
 
     def integer(self, what: str, lo: int | None = None, hi: int | None = None) -> int:
@@ -168,10 +168,10 @@ class Tokens:
             except ValueError:
                 f = math.nan
             if not (math.isfinite(f) and f == int(f) and abs(f) < 2**53):
-                self.error(f"expected a whole number for {what}, found '{_show(tok)}'.", self.pos - 1)
+                self.error(f"expected a whole number for {what}, found '{show(tok)}'.", self.pos - 1)
             v = int(f)
         if abs(v) >= 2**53:  # no count or index is this large; numpy could not hold it either
-            self.error(f"{what} is out of range, found '{_show(tok)}'.", self.pos - 1)
+            self.error(f"{what} is out of range, found '{show(tok)}'.", self.pos - 1)
         if lo is not None and v < lo:
             self.error(f"{what} must be at least {lo}, found {v}.", self.pos - 1)
         if hi is not None and v > hi:
@@ -203,11 +203,11 @@ class Tokens:
                 try:
                     float(tok)
                 except ValueError:
-                    self.error(f"expected a number in {what}, found '{_show(tok)}'.", start + i)
+                    self.error(f"expected a number in {what}, found '{show(tok)}'.", start + i)
             raise  # pragma: no cover - numpy and float() agree on what a number is
         if not np.all(np.isfinite(arr)):
             bad = int(np.argmin(np.isfinite(arr)))
-            self.error(f"{what} must hold finite numbers, found '{_show(chunk[bad])}'.", start + bad)
+            self.error(f"{what} must hold finite numbers, found '{show(chunk[bad])}'.", start + bad)
         self.pos += n
         return arr
 
@@ -218,15 +218,11 @@ class Tokens:
         bad = np.nonzero((arr != np.round(arr)) | (np.abs(arr) > 2**53))[0]
         if len(bad):
             i = int(bad[0])
-            self.error(f"expected a whole number in {what}, found '{_show(self.toks[start + i])}'.", start + i)
+            self.error(f"expected a whole number in {what}, found '{show(self.toks[start + i])}'.", start + i)
         return arr.astype(np.int64)
 
 
-def _show(tok: str, limit: int = 40) -> str:
+def show(tok: str, limit: int = 40) -> str:
     """A token as it may appear in a message (shortened, no control characters)."""
     clean = "".join(c if c.isprintable() else "?" for c in tok)
     return clean if len(clean) <= limit else clean[: limit - 1] + "…"
-
-
-def show(tok: str) -> str:
-    return _show(tok)

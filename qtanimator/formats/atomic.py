@@ -16,13 +16,8 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
     target = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
     try:
-        # mkstemp makes the file private (0600); give it the mode the old file had, or
-        # the mode a plain open() would have given under the current umask.
-        try:
-            mode = os.stat(target).st_mode & 0o7777
-        except OSError:
-            mode = 0o666 & ~_UMASK
-        os.chmod(tmp, mode)
+        # mkstemp makes the file private (0600); a save must not change who may read it.
+        os.chmod(tmp, mode_for(target))
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
             fh.flush()

@@ -35,7 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key, Tangent
-from qtanimator.core.skeleton import Joint, Skeleton
+from qtanimator.core.skeleton import Joint, Skeleton, axis_rotations
 from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.errors import FormatError
 
@@ -254,7 +254,7 @@ class BvhClip:
                 if self._kinds[col] == 0:
                     trans[:, axis] += v
                 else:
-                    rot = rot @ _axis_rotation(axis, v)
+                    rot = rot @ axis_rotations(axis, v)
             local[:, :3, :3] = rot
             local[:, :3, 3] = trans
             if joint.parent is None:
@@ -315,20 +315,6 @@ class BvhClip:
             "duration": self.duration,
             "rotation_orders": orders,
         }
-
-
-def _axis_rotation(axis: int, angles: FloatArray) -> FloatArray:
-    """(F, 3, 3) right-handed rotations about x (0), y (1) or z (2) by ``angles`` radians."""
-    c = np.cos(angles)
-    s = np.sin(angles)
-    r = np.zeros((angles.shape[0], 3, 3))
-    i, j = [(1, 2), (2, 0), (0, 1)][axis]
-    r[:, axis, axis] = 1.0
-    r[:, i, i] = c
-    r[:, j, j] = c
-    r[:, i, j] = -s
-    r[:, j, i] = s
-    return r
 
 
 def _column_tables(joints: Sequence[BvhJoint]) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64],

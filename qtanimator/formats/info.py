@@ -1,6 +1,6 @@
 """``qtanimator info``: a short summary of any file qtanimator reads.
 
-Each format registers a summariser for its suffixes; the summary is plain JSON data.
+Each format module has a summariser for its suffixes; the summary is plain JSON data.
 """
 
 from __future__ import annotations
@@ -40,11 +40,7 @@ def summarize(path: Path) -> dict[str, Any]:
     entry = SUMMARISERS.get(suffix)
     if entry is None:
         raise FormatError(f"qtanimator does not read '{path.suffix}' files.", path)
-    try:
-        module = importlib.import_module(entry[0])
-        fn: Summariser = getattr(module, entry[1])
-    except (ImportError, AttributeError) as exc:
-        raise FormatError(f"this qtanimator cannot summarise '{suffix}' files yet.", path) from exc
+    fn: Summariser = getattr(importlib.import_module(entry[0]), entry[1])
     return fn(path)
 
 

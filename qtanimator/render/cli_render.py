@@ -190,7 +190,7 @@ def render_main(argv: Sequence[str]) -> int:
                 print(f"qtanimator render: the 3D view is not available ({exc}).", file=sys.stderr)
                 return 2
             # the 3D renderer knows how to get a GL-capable platform (a private Xvfb headless)
-            getattr(render3d, "ensure_gui_application", _ensure_gui_app)()
+            render3d.ensure_gui_application()
         else:
             _ensure_gui_app()
         from qtanimator.render.painter2d import background_color

@@ -16,7 +16,7 @@ import contextlib
 import io
 import os
 import tempfile
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
@@ -65,6 +65,23 @@ def _check_frame(frame: npt.ArrayLike, shape: tuple[int, ...] | None) -> Frame:
     return a
 
 
+def _checked_frames(frames: Iterable[npt.ArrayLike], progress: Callable[[int], None] | None,
+                    cancel: Callable[[], bool] | None) -> Iterator[Frame]:
+    """``frames`` checked for type and a common size, stopping when ``cancel()`` says so;
+    ``progress(n)`` is called once the consumer has written frame ``n``."""
+    shape = None
+    done = 0
+    for frame in frames:
+        if cancel is not None and cancel():
+            return
+        a = _check_frame(frame, shape)
+        shape = a.shape
+        yield a
+        done += 1
+        if progress is not None:
+            progress(done)
+
+
 def flatten_alpha(frame: Frame, background: tuple[int, int, int] = (255, 255, 255)) -> Frame:
     """An RGB copy of an RGBA frame composited over ``background``."""
     if frame.shape[2] == 3:
@@ -106,16 +123,9 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
             parent = os.path.dirname(path)
             if parent:
                 os.makedirs(parent, exist_ok=True)
-        shape = None
-        for frame in frames:
-            if cancel is not None and cancel():
-                break
-            a = _check_frame(frame, shape)
-            shape = a.shape
+        for a in _checked_frames(frames, progress, cancel):
             iio.imwrite(pattern % (start + count), a)
             count += 1
-            if progress is not None:
-                progress(count)
         return count
     parent = os.path.dirname(os.path.abspath(path))
     os.makedirs(parent, exist_ok=True)
@@ -123,16 +133,9 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
         from PIL import Image
 
         images: list[Image.Image] = []
-        shape = None
-        for frame in frames:
-            if cancel is not None and cancel():
-                break
-            a = _check_frame(frame, shape)
-            shape = a.shape
+        for a in _checked_frames(frames, progress, cancel):
             images.append(Image.fromarray(flatten_alpha(a)).convert("P", palette=Image.Palette.ADAPTIVE))
             count += 1
-            if progress is not None:
-                progress(count)
         if images:
             buffer = io.BytesIO()
             images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:], loop=0,
@@ -147,22 +150,15 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
     fd, tmp = tempfile.mkstemp(prefix=f".{Path(path).name}.", suffix=Path(path).suffix, dir=parent)
     os.close(fd)
     writer = None
-    shape = None
     done = False
     try:
-        for frame in frames:
-            if cancel is not None and cancel():
-                break
-            a = _check_frame(frame, shape)
-            shape = a.shape
+        for a in _checked_frames(frames, progress, cancel):
             if writer is None:
                 writer = iio2.get_writer(tmp, format="FFMPEG", mode="I", fps=float(fps), codec=codec,
                                          macro_block_size=1, quality=8, pixelformat="yuv420p",
                                          output_params=["-movflags", "+faststart"] if codec == "libx264" else None)
             writer.append_data(_even(flatten_alpha(a)))
             count += 1
-            if progress is not None:
-                progress(count)
         if writer is not None:
             writer.close()
             writer = None

@@ -17,7 +17,7 @@ from PySide6.QtCore import QPointF, QRectF, Qt
 from PySide6.QtGui import QBrush, QColor, QImage, QPainter, QPainterPath, QPen, QPolygonF, QTransform
 
 from qtanimator.core.rig2d import RGBA, Character, Pose, Shape
-from qtanimator.document.character2d import ASSET_KIND, character, evaluate_pose
+from qtanimator.document.character2d import character, character_assets, evaluate_pose
 from qtanimator.document.document import Document
 
 _PATHS: weakref.WeakKeyDictionary[Character, list[list[QPainterPath]]] = weakref.WeakKeyDictionary()
@@ -115,18 +115,17 @@ def draw_character(painter: QPainter, ch: Character, pose: Pose, *, highlight: i
     painter.restore()
 
 
-def character_ids(doc: Document) -> list[str]:
-    return [a.id for a in doc.assets.values() if a.kind == ASSET_KIND]
+def _poses_bounds(doc: Document, poses: dict[str, Pose]) -> QRectF:
+    rect = QRectF()
+    for aid, pose in poses.items():
+        x0, y0, x1, y1 = character(doc, aid).bounds(pose)
+        rect = rect.united(QRectF(x0, y0, max(x1 - x0, 1e-6), max(y1 - y0, 1e-6)))
+    return rect
 
 
 def scene_bounds(doc: Document, time: float) -> QRectF:
     """The bounding box of every 2D character posed at ``time`` (empty rect if none)."""
-    rect = QRectF()
-    for aid in character_ids(doc):
-        ch = character(doc, aid)
-        x0, y0, x1, y1 = ch.bounds(evaluate_pose(doc, aid, time))
-        rect = rect.united(QRectF(x0, y0, max(x1 - x0, 1e-6), max(y1 - y0, 1e-6)))
-    return rect
+    return _poses_bounds(doc, {aid: evaluate_pose(doc, aid, time) for aid in character_assets(doc)})
 
 
 def animation_bounds(doc: Document, times: Iterable[float]) -> QRectF:
@@ -170,13 +169,10 @@ def render_frame(doc: Document, time: float, size: tuple[int, int] = (960, 640),
         raise ValueError("the image size must be positive")
     image = QImage(w, h, QImage.Format.Format_ARGB32_Premultiplied)
     image.fill(background_color(background))
-    ids = list(assets) if assets is not None else character_ids(doc)
+    ids = list(assets) if assets is not None else character_assets(doc)
     poses = {aid: evaluate_pose(doc, aid, time) for aid in ids}
     if view is None:
-        view = QRectF()
-        for aid, pose in poses.items():
-            x0, y0, x1, y1 = character(doc, aid).bounds(pose)
-            view = view.united(QRectF(x0, y0, max(x1 - x0, 1e-6), max(y1 - y0, 1e-6)))
+        view = _poses_bounds(doc, poses)
     painter = QPainter(image)
     try:
         painter.setRenderHint(QPainter.RenderHint.Antialiasing, True)

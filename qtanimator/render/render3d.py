@@ -19,13 +19,14 @@ from collections.abc import Iterable, Iterator
 from typing import Any
 
 import numpy as np
-from PySide6.QtGui import QGuiApplication, QImage, QOffscreenSurface, QOpenGLContext
+from PySide6.QtGui import QGuiApplication, QOffscreenSurface, QOpenGLContext
 from PySide6.QtOpenGL import QOpenGLFramebufferObject, QOpenGLFramebufferObjectFormat
 
 from qtanimator.render.gl import surface_format
 from qtanimator.render.gl.camera import OrbitCamera
 from qtanimator.render.gl.lights import ambient_of, lights_of
 from qtanimator.render.gl.renderer import SceneItem, SceneRenderer, ViewOptions, grid_scale_for
+from qtanimator.render.painter2d import image_to_array
 from qtanimator.render.scene3d import scene_bounds, scene_items
 
 
@@ -110,8 +111,7 @@ class OffscreenGL:
     def read(self) -> np.ndarray:
         """The framebuffer as an H×W×4 RGBA uint8 array (top row first)."""
         assert self.fbo is not None
-        image = self.fbo.toImage().convertToFormat(QImage.Format.Format_RGBA8888)
-        return qimage_to_array(image)
+        return image_to_array(self.fbo.toImage())
 
     def close(self) -> None:
         if self.fbo is not None:
@@ -120,12 +120,6 @@ class OffscreenGL:
             self.fbo = None
         self.context.doneCurrent()
 
-
-def qimage_to_array(image: QImage) -> np.ndarray:
-    w, h = image.width(), image.height()
-    ptr = image.constBits()
-    arr = np.frombuffer(ptr, dtype=np.uint8, count=image.sizeInBytes()).reshape(h, image.bytesPerLine())
-    return arr[:, : w * 4].reshape(h, w, 4).copy()
 
 
 def default_camera(items: list[SceneItem], doc: Any = None) -> OrbitCamera:

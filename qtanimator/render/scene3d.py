@@ -14,27 +14,14 @@ from typing import Any
 
 import numpy as np
 
+from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN
+from qtanimator.core.skinning import vertex_normals
+from qtanimator.document import character3d, cloth
 from qtanimator.render.gl.meshes import csr_influences
 from qtanimator.render.gl.renderer import CharacterDraw, ClothDraw, PlaneDraw, SceneItem, SkinDraw
 
-CHARACTER_KIND = "character3d"
-CLOTH_KIND = "cloth"
-
-
-def _character3d() -> Any:
-    try:
-        from qtanimator.document import character3d
-    except ImportError:
-        return None
-    return character3d
-
-
-def _cloth_doc() -> Any:
-    try:
-        from qtanimator.document import cloth
-    except ImportError:
-        return None
-    return cloth
+CHARACTER_KIND = character3d.ASSET_KIND
+CLOTH_KIND = cloth.ASSET_KIND
 
 
 def scene_items(doc: Any, time: float, selection: tuple[str, str] = ("", ""),
@@ -68,10 +55,7 @@ def scene_items(doc: Any, time: float, selection: tuple[str, str] = ("", ""),
 
 def character_item(doc: Any, asset_id: str, time: float,
                    selection: tuple[str, str] = ("", "")) -> CharacterDraw | None:
-    mod = _character3d()
-    if mod is None:
-        return None
-    skel = mod.pose_skeleton(doc, asset_id, time)
+    skel = character3d.pose_skeleton(doc, asset_id, time)
     world = np.asarray(skel.world_matrices(), dtype=float)
     selected = None
     if selection[0] == asset_id and selection[1]:
@@ -89,8 +73,6 @@ def character_item(doc: Any, asset_id: str, time: float,
 
 def draws_boxes(skel: Any) -> bool:
     """Balljoint skeletons with boxes draw them; others (MIT, BVH, no boxes) draw spheres and bones."""
-    from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN
-
     if skel.rotation_order != "zyx" or not skel.joints:
         return False
     return any(not (np.allclose(j.boxmin, DEFAULT_BOXMIN) and np.allclose(j.boxmax, DEFAULT_BOXMAX))
@@ -160,13 +142,10 @@ def cloth_item(doc: Any, asset_id: str, time: float, live: Any = None) -> ClothD
         normals = np.asarray(live.normals(), dtype=float)
         triangles, params, pinned = live.triangles, live.params, live.pinned
     else:
-        mod = _cloth_doc()
-        if mod is None:
-            return None
-        cache = mod.cloth_cache(doc, asset_id)
+        cache = cloth.cloth_cache(doc, asset_id)
         positions = np.asarray(cache.positions(doc.time_to_frame(time)), dtype=float)
         triangles, params, pinned = cache.triangles, cache.params, cache.cloth.pinned
-        normals = smooth_normals(positions, np.asarray(triangles, dtype=np.int64))
+        normals = vertex_normals(positions, np.asarray(triangles, dtype=np.int64))
     item = ClothDraw(asset_id, positions, normals, np.asarray(triangles, dtype=np.int64))
     for s in getattr(params, "spheres", None) or []:
         item.spheres.append((np.asarray(s[0], dtype=float), float(s[1])))
@@ -177,13 +156,6 @@ def cloth_item(doc: Any, asset_id: str, time: float, live: Any = None) -> ClothD
         if idx.size:
             item.pinned = positions[idx.astype(np.int64)]
     return item
-
-
-def smooth_normals(positions: np.ndarray, triangles: np.ndarray) -> np.ndarray:
-    """Area-weighted vertex normals (zero-area triangles add nothing)."""
-    from qtanimator.core.skinning import vertex_normals
-
-    return vertex_normals(positions, triangles)
 
 
 def scene_bounds(items: Iterable[SceneItem]) -> tuple[np.ndarray, np.ndarray] | None:

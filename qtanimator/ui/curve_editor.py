@@ -287,4 +287,7 @@ def install(window: Any) -> CurveEditor:
     editor = CurveEditor(window.ctx, window)
     window.curve_editor = editor
     window.add_dock("curveEditorDock", "Curve Editor", editor, Qt.DockWidgetArea.BottomDockWidgetArea)
+    from qtanimator.ui.timeline import add_timeline_keys
+
+    add_timeline_keys(window, editor.plot)  # the timeline is installed before this editor
     return editor

@@ -50,7 +50,6 @@ def show_character(window: Any, asset_id: str) -> None:
     if panel is None or view is None:
         return
     window.central_tabs.setCurrentWidget(panel)
-    from qtanimator.render.gl.renderer import grid_scale_for
     from qtanimator.render.scene3d import scene_bounds
 
     try:
@@ -60,8 +59,7 @@ def show_character(window: Any, asset_id: str) -> None:
     chosen = [i for i in items if getattr(i, "asset_id", None) == asset_id]
     bounds = scene_bounds(chosen or items)
     if bounds is not None:
-        view.camera.frame(*bounds)
-        view.options.grid_scale = grid_scale_for(*bounds)
+        view.frame_bounds(bounds)
     view.update()
 
 

@@ -72,6 +72,9 @@ class MainWindow(QMainWindow):
         self.setObjectName("mainWindow")
         self.ctx = EditorContext(doc, self)
         self.openers: dict[str, Opener] = {}
+        #: Called before the document is written (Save, Save As, autosave): editors put view
+        #: state such as the 3D camera into the document here, without an undo step.
+        self.save_hooks: list[Callable[[], None]] = []
         self.setAcceptDrops(True)
         self.setDockNestingEnabled(True)
         self.resize(1400, 900)
@@ -258,8 +261,14 @@ class MainWindow(QMainWindow):
             path += PROJECT_SUFFIX
         return self.save_to(path)
 
+    def prepare_save(self) -> None:
+        """Let the editors store their view state in the document (see ``save_hooks``)."""
+        for hook in self.save_hooks:
+            hook()
+
     def save_to(self, path: str | os.PathLike[str]) -> bool:
         try:
+            self.prepare_save()
             save_document(self.doc, path)
         except (OSError, ValueError) as exc:
             self.show_error("Cannot save", f"{Path(path).name}: {exc}")

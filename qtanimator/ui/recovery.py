@@ -152,6 +152,7 @@ class RecoveryManager(QObject):
             return False
         doc = self.window.doc
         try:
+            self.window.prepare_save()
             self.project_path.parent.mkdir(parents=True, exist_ok=True)
             save_project(to_project_data(doc), self.project_path)
             note = {"pid": os.getpid(), "original_path": doc.path, "saved_at": time.time(),

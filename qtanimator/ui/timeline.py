@@ -351,15 +351,21 @@ def _make_actions(window: MainWindow, playback: Playback, control: TimelineContr
     return actions
 
 
-#: Widgets (by object name) that get the timeline's keys when they have the focus.
-KEY_TARGETS = ("rigEditorView", "viewport3d", "curvePlot", "jointTreeDock")
+#: Widgets (by object name) that get the timeline's keys when they have the focus. Trees,
+#: lists and sliders (the Joints dock, the curve editor's channel tree) keep their arrow keys.
+KEY_TARGETS = ("rigEditorView", "viewport3d", "curvePlot")
 
 
 def add_timeline_keys(window: MainWindow, widget: QWidget) -> None:
-    """Give ``widget`` the timeline's keys (arrows, Home/End, [ ]) while it has the focus."""
+    """Give ``widget`` the timeline's keys (arrows, Home/End, [ ]) while it has the focus.
+
+    Editors installed after the timeline call this themselves; editors installed before it
+    are found by object name (:data:`KEY_TARGETS`) when the timeline is installed.
+    """
     actions = getattr(window, "timeline_actions", None)
     if actions:
-        widget.addActions(list(actions.values()))
+        present = set(widget.actions())
+        widget.addActions([a for a in actions.values() if a not in present])
 
 
 def install(window: MainWindow) -> None:

@@ -69,6 +69,10 @@ PIN_TURNS = {Qt.Key.Key_Z: PIN_TURN, Qt.Key.Key_C: -PIN_TURN}
 SIM_DT = 1.0 / 60.0
 
 
+#: The document parameter holding the 3D camera (view state, written when saving).
+CAMERA_PARAMETER = "view3d.camera"
+
+
 class LiveCloths:
     """Interactive cloth simulations, one per cloth asset, stepped by the wall clock.
 
@@ -177,7 +181,8 @@ class Viewport3D(QOpenGLWidget):
         self.last_frame_ms = 0.0
         self.gl_info = ""
         self._items: list[SceneItem] = []
-        self._framed_once = False
+        self._framed_once = False   # the camera frames the scene at the first paint with items
+        self._grid_pending = False  # a restored camera: size the grid at the first paint
         self._drag: dict[str, Any] | None = None
         self._press_pos = QPointF()
         ctx.frameChanged.connect(lambda _f: self.update())
@@ -190,6 +195,7 @@ class Viewport3D(QOpenGLWidget):
         self._sim_timer.setInterval(16)
         self._sim_timer.timeout.connect(self._tick_cloth)
         self.live.sync(ctx.doc)
+        self.restore_camera()
 
     # ------------------------------------------------------------ document
     def _on_document_changed(self, event: Any) -> None:
@@ -200,7 +206,7 @@ class Viewport3D(QOpenGLWidget):
     def _on_document_reset(self) -> None:
         self.live.cloths.clear()
         self.live.sync(self.ctx.doc)
-        self._framed_once = False
+        self.restore_camera()
         self.update()
 
     def set_live_cloth(self, enabled: bool) -> None:
@@ -256,6 +262,11 @@ class Viewport3D(QOpenGLWidget):
         if not self._framed_once and self._items:
             self.frame_all()
             self._framed_once = True
+        elif self._grid_pending and self._items:
+            bounds = scene_bounds(self._items)
+            if bounds is not None:
+                self.options.grid_scale = grid_scale_for(*bounds)
+            self._grid_pending = False
         ratio = self.devicePixelRatioF()
         w, h = max(1, int(self.width() * ratio)), max(1, int(self.height() * ratio))
         doc = self.ctx.doc
@@ -268,11 +279,64 @@ class Viewport3D(QOpenGLWidget):
         """The current picture as an H×W×4 RGBA uint8 array (renders a frame)."""
         from PySide6.QtGui import QImage
 
-        from qtanimator.render.render3d import qimage_to_array
+        from qtanimator.render.painter2d import image_to_array
 
-        return qimage_to_array(self.grabFramebuffer().convertToFormat(QImage.Format.Format_RGBA8888))
+        return image_to_array(self.grabFramebuffer().convertToFormat(QImage.Format.Format_RGBA8888))
 
     # ------------------------------------------------------------- camera
+    def restore_camera(self) -> bool:
+        """Take the camera stored in the document (``view3d.camera``); without one (or with
+        an unreadable one) the view frames the scene at its next paint. True if restored."""
+        stored = self.ctx.doc.parameters.get(CAMERA_PARAMETER)
+        camera = OrbitCamera()
+        try:
+            if not isinstance(stored, dict):
+                raise ValueError("no stored camera")
+            camera.azimuth = float(stored.get("azimuth", camera.azimuth))
+            camera.inclination = float(stored.get("inclination", camera.inclination))
+            camera.distance = float(stored.get("distance", camera.distance))
+            camera.fov_y = float(stored.get("fov_y", camera.fov_y))
+            target = np.asarray(stored.get("target", [0.0, 0.0, 0.0]), dtype=float)
+            if target.shape != (3,) or not np.all(np.isfinite(target)) or not all(
+                    math.isfinite(v) for v in (camera.azimuth, camera.inclination, camera.distance, camera.fov_y)):
+                raise ValueError("bad stored camera")
+            camera.target = target
+        except (TypeError, ValueError):
+            self._framed_once = False
+            self._grid_pending = False
+            return False
+        self.camera = camera
+        self._framed_once = True
+        self._grid_pending = True
+        return True
+
+    def camera_state(self) -> dict[str, Any]:
+        """The camera as plain JSON data (what ``view3d.camera`` holds)."""
+        c = self.camera
+        return {"azimuth": float(c.azimuth), "inclination": float(c.inclination), "distance": float(c.distance),
+                "target": [float(v) for v in np.asarray(c.target, dtype=float)], "fov_y": float(c.fov_y)}
+
+    def store_camera(self) -> None:
+        """Save hook: put the camera into the document's ``view3d.camera`` parameter.
+
+        Camera moves are view state, not edits: this writes the parameter directly (no
+        command, no undo step, the document is not marked modified). Only a camera that has
+        framed or shown a scene is stored; an untouched document keeps what it had.
+        """
+        if not self._framed_once:
+            return
+        state = self.camera_state()
+        if self.ctx.doc.parameters.get(CAMERA_PARAMETER) != state:
+            self.ctx.doc.parameters[CAMERA_PARAMETER] = state
+
+    def frame_bounds(self, bounds: tuple[np.ndarray, np.ndarray]) -> None:
+        """Point the camera at a box (a new 3D asset frames itself this way)."""
+        self.camera.frame(*bounds)
+        self.options.grid_scale = grid_scale_for(*bounds)
+        self._framed_once = True
+        self._grid_pending = False
+        self.update()
+
     def frame_all(self) -> None:
         items = self._items or self.build_items()
         bounds = scene_bounds(items)
@@ -763,6 +827,7 @@ def install(window: Any) -> None:
     panel = ViewportPanel(window.ctx, window, window)
     window.viewport_panel = panel
     window.viewport3d = panel.view
+    window.save_hooks.append(panel.view.store_camera)
     window.add_central(panel, "3D")
     frame = window._action("actionFrameSelection3d", "Frame Selection (3D)", panel.view.frame_selection)
     window.view_menu.addAction(frame)

@@ -508,3 +508,106 @@ def test_right_click_opens_the_edit_menu(qtbot, editor):
     assert "Tangents" in titles and "Extrapolation" in titles
     menu.close()
     assert ed.view.selected_keys() == {"hero//y": [1]}  # a right click keeps the selection
+
+
+# ----------------------------------------------------------- polish (issue: rough edges)
+def _open_rows(tree) -> set[tuple[str, str]]:
+    view = tree.view
+    return {path for path, item in tree._groups.items()
+            if view.isExpanded(tree.proxy.mapFromSource(item.index()))}
+
+
+def test_channel_tree_keeps_expansion_and_scroll_when_channels_change(qtbot, editor):
+    from qtanimator.document import InsertKey
+
+    ed = editor
+    tree = ed.tree
+    for j in range(12):  # enough rows to scroll
+        ed.ctx.doc.channels[f"hero/bone{j:02d}/angle"] = Channel([Key(0.0, 0.0), Key(1.0, 0.1 * j)])
+    ed.ctx.replace_document(ed.ctx.doc)
+    ed.splitter.setSizes([200, 800])
+    ed.resize(1000, 260)
+    QApplication.processEvents()
+    view = tree.view
+    # Open the arm and three bones: click the row, Right opens it.
+    for joint in ("arm", "bone03", "bone07", "bone10"):
+        index = tree.proxy.mapFromSource(tree._groups[("hero", joint)].index())
+        view.scrollTo(index)
+        qtbot.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, pos=view.visualRect(index).center())
+        qtbot.keyClick(view, Qt.Key.Key_Right)
+        assert view.isExpanded(index)
+    bar = view.verticalScrollBar()
+    bar.setValue(bar.maximum() // 2 + 1)
+    opened, scroll = _open_rows(tree), bar.value()
+    assert {("hero", "arm"), ("hero", "bone07")} <= opened and scroll > 0
+    # A new channel (another joint keyed) rebuilds the tree: nothing collapses or jumps.
+    ed.ctx.push(InsertKey(ed.ctx.doc, "hero/tail/angle", Key(0.2, 0.3)))
+    assert "hero/tail/angle" in tree.channel_ids()
+    assert _open_rows(tree) == opened
+    assert bar.value() == scroll
+    ed.ctx.undo_stack.undo()
+    assert "hero/tail/angle" not in tree.channel_ids()
+    assert _open_rows(tree) == opened and bar.value() == scroll
+
+
+def test_selection_stays_on_the_same_keys_after_undoing_a_move_past_others(qtbot, editor):
+    ed = editor
+    cid = "hero//x"
+    keys = ed.ctx.doc.channels[cid].keys  # frames 0, 30, 60
+    qtbot.mouseClick(ed.plot.viewport(), Qt.MouseButton.LeftButton, pos=key_pos(ed, cid, 0))
+    assert ed.view.selected_keys() == {cid: [0]}
+    # Drag the first key past the second one: it becomes key 1.
+    drag(qtbot, ed, key_pos(ed, cid, 0), view_pos(ed, 45, 0.0))
+    moved = ed.ctx.doc.channels[cid].keys
+    assert moved[1].time * FPS == pytest.approx(45.0) and ed.view.selected_keys() == {cid: [1]}
+    ed.ctx.undo_stack.undo()
+    assert ed.ctx.doc.channels[cid].keys == keys
+    assert ed.view.selected_keys() == {cid: [0]}  # the key that moved, not the one now at index 1
+    assert ed.view.active == (cid, 0)
+    assert ed.fields.frame.value() == pytest.approx(0.0)
+    ed.ctx.undo_stack.redo()
+    assert ed.view.selected_keys() == {cid: [1]} and ed.view.active == (cid, 1)
+    # A change that removes the selected key clears the selection.
+    from qtanimator.document import DeleteKeys
+
+    ed.ctx.push(DeleteKeys(ed.ctx.doc, {cid: [1]}))
+    assert ed.view.selected_keys() == {}
+
+
+def test_dragging_on_the_time_axis_scrubs(qtbot, editor):
+    ed = editor
+    ed.ctx.set_frame(5.0)
+    y = ed.plot.mapFromScene(ed.view.vb.sceneBoundingRect().bottomLeft()).y() + 12  # on the time axis
+    seen = []
+    ed.ctx.frameChanged.connect(seen.append)
+    range_before = ed.view.vb.viewRange()
+    drag(qtbot, ed, QPoint(view_pos(ed, 10, 0).x(), y), QPoint(view_pos(ed, 70.2, 0).x(), y), steps=6)
+    assert ed.ctx.frame == 70.0
+    assert len(seen) >= 3 and all(f == round(f) for f in seen)  # followed the mouse, whole frames
+    assert ed.view.vb.viewRange() == range_before  # the axis did not pan
+    assert ed.ctx.doc.state() == make_doc().state()
+
+
+def test_hover_highlights_keys_and_handles_and_sets_the_cursor(qtbot, editor):
+    ed = editor
+    vp = ed.plot.viewport()
+    cid = "hero//y"
+    qtbot.mouseMove(vp, view_pos(ed, 20, -1.2))
+    assert ed.view.hover is None and vp.cursor().shape() == Qt.CursorShape.ArrowCursor
+    qtbot.mouseMove(vp, key_pos(ed, cid, 1) + QPoint(2, 1))
+    assert ed.view.hover == ("key", cid, 1)
+    assert vp.cursor().shape() == Qt.CursorShape.SizeAllCursor
+    layer = [d for d in ed.view._layer_drawings(False) if d.cid == cid][0].keys
+    assert layer.hover_key == 1
+    # Select it: its handles show; hovering one highlights it with a pointing hand.
+    qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, pos=key_pos(ed, cid, 1))
+    _key, _hin, hout = ed.view.handle_positions(cid, 1)
+    qtbot.mouseMove(vp, ed.plot.mapFromScene(hout))
+    assert ed.view.hover == ("handle", cid, 1, "out")
+    assert vp.cursor().shape() == Qt.CursorShape.PointingHandCursor
+    layer = [d for d in ed.view._layer_drawings(True) if d.cid == cid][0].keys
+    assert layer.hover_handle == (0, "out")
+    image_hover = ed.plot.grab().toImage()
+    qtbot.mouseMove(vp, view_pos(ed, 20, -1.2))
+    assert ed.view.hover is None and vp.cursor().shape() == Qt.CursorShape.ArrowCursor
+    assert ed.plot.grab().toImage() != image_hover  # the highlight is drawn

@@ -11,7 +11,8 @@ from hypothesis import strategies as st
 
 from qtanimator.core.channel import Channel, Extrapolation, Key, Tangent
 from qtanimator.document import Document, UndoStack
-from qtanimator.document.curve_commands import MoveCurveKeys, SetKeysBroken, SetKeySlopes
+from qtanimator.document.commands import MoveKeys
+from qtanimator.document.curve_commands import SetKeysBroken, SetKeySlopes
 from qtanimator.ui.curves.sampling import SampleCache, channel_normalisation, sample_channel
 
 RULES = ["flat", "linear", "smooth", "clamped"]
@@ -37,7 +38,7 @@ def test_move_keeps_rules_and_slopes_and_undo_is_exact(ch, data):
     dv = data.draw(st.floats(-3, 3))
     stack = UndoStack(doc)
     try:
-        cmd = MoveCurveKeys({"a/j/rx": ch}, {"a/j/rx": idx}, dt, {"a/j/rx": dv}, gesture="g")
+        cmd = MoveKeys({"a/j/rx": ch}, {"a/j/rx": idx}, dt, {"a/j/rx": dv}, gesture="g")
     except ValueError:
         return  # two keys would share a time
     stack.push(cmd)
@@ -59,7 +60,7 @@ def test_time_scale_divides_fixed_slopes_and_merges_in_one_gesture():
     doc.channels["c//x"] = ch
     stack = UndoStack(doc)
     for f in (1.5, 2.0, 0.5):
-        stack.push(MoveCurveKeys({"c//x": ch}, {"c//x": [0, 1]}, 0.0, 0.0, gesture="s", time_scale=(0.0, f)))
+        stack.push(MoveKeys({"c//x": ch}, {"c//x": [0, 1]}, 0.0, 0.0, gesture="s", time_scale=(0.0, f)))
     assert len(stack.done) == 1
     new = doc.channels["c//x"]
     assert [k.time for k in new.keys] == [0.0, 0.5]

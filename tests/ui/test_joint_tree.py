@@ -6,7 +6,7 @@ import math
 
 import pytest
 from PySide6.QtCore import QPoint, Qt
-from PySide6.QtWidgets import QDockWidget, QDoubleSpinBox, QSlider, QStyle, QStyleOptionSlider
+from PySide6.QtWidgets import QDockWidget, QDoubleSpinBox, QSlider, QStyle, QStyleOptionSlider, QWidget
 
 from qtanimator.document import character2d as c2d
 
@@ -147,3 +147,43 @@ def test_3d_skeleton_joints_and_dof_limits(make_window, qtbot, shared_data):
     assert [r.spec.label for r in panel.dofs.rows] == ["translate x", "translate y", "translate z"]
     panel.dofs.rows[1].spin.setValue(0.5)
     assert c3d.pose_skeleton(window.doc, aid, 0.0).root_translation[1] == pytest.approx(0.5)
+
+
+
+def test_arrow_keys_move_between_tree_rows_not_frames(make_window, qtbot):
+    """Up / Down on the tree move the current row; the timeline keys stay in the rig editor,
+    the 3D viewport and the curve plot."""
+    from qtanimator.paths import scenes_dir
+
+    window = make_window(full=True, size=(1400, 900))
+    assert window.open_path(scenes_dir() / "pendulum_clock.svg")
+    tree = window.joint_tree.tree
+    window.ctx.set_frame(30)
+    top = tree.topLevelItem(0)
+    first = top.child(0)
+    qtbot.mouseClick(tree.viewport(), Qt.MouseButton.LeftButton, pos=tree.visualItemRect(first).center())
+    assert tree.hasFocus() and window.ctx.selection == first.data(0, Qt.ItemDataRole.UserRole)
+    qtbot.keyClick(tree, Qt.Key.Key_Down)
+    assert window.ctx.frame == 30  # not "go to the last frame"
+    below = tree.itemBelow(first)
+    assert tree.currentItem() is below
+    assert window.ctx.selection == below.data(0, Qt.ItemDataRole.UserRole)
+    qtbot.keyClick(tree, Qt.Key.Key_Up)
+    assert window.ctx.frame == 30 and tree.currentItem() is first
+    qtbot.keyClick(tree, Qt.Key.Key_Up)
+    assert tree.currentItem() is top and window.ctx.selection == (top.text(0), "")
+    # Left closes the branch instead of stepping a frame; Right opens it again.
+    qtbot.keyClick(tree, Qt.Key.Key_Left)
+    assert not top.isExpanded() and window.ctx.frame == 30
+    qtbot.keyClick(tree, Qt.Key.Key_Right)
+    assert top.isExpanded() and window.ctx.frame == 30
+    # The timeline keys work in the rig editor and in the curve plot.
+    for name in ("rigEditorView", "curvePlot"):
+        view = window.findChild(QWidget, name)
+        window.ctx.set_frame(30)
+        view.setFocus()
+        qtbot.waitUntil(view.hasFocus)
+        qtbot.keyClick(view, Qt.Key.Key_Right)
+        assert window.ctx.frame == 31, name
+        qtbot.keyClick(view, Qt.Key.Key_Down)
+        assert window.ctx.frame == window.doc.frame_range[1], name

@@ -406,3 +406,50 @@ def test_status_text_does_not_resize_the_view(window, qtbot):
         panel.status.setText(text)
         qtbot.wait(20)
         assert panel.view.width() == width
+
+
+def test_camera_is_saved_with_the_project_without_an_undo_step_and_restored(qtbot, tmp_path):
+    from qtanimator.document.character3d import add_character3d_command
+    from qtanimator.paths import scenes_dir
+    from qtanimator.ui import import3d
+
+    w = MainWindow(install_editors=("viewport", "import3d"))
+    qtbot.addWidget(w)
+    w.resize(420, 360)
+    w.show()
+    qtbot.waitExposed(w)
+    view = w.viewport3d
+    arm = scenes_dir() / "arm3d"
+    w.ctx.push(add_character3d_command(w.doc, arm / "arm.skel", arm / "arm.skin", asset_id="arm"))
+    w.ctx.undo_stack.setClean()
+    view.render_image()  # the first paint frames the arm
+    framed = view.camera_state()
+    # Orbit, pan and zoom with the mouse: the view changes, the document does not.
+    qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=QPoint(100, 100))
+    qtbot.mouseMove(view, QPoint(140, 120))
+    qtbot.mouseMove(view, QPoint(180, 150))
+    qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=QPoint(180, 150))
+    qtbot.mousePress(view, Qt.MouseButton.MiddleButton, pos=QPoint(100, 100))
+    qtbot.mouseMove(view, QPoint(130, 90))
+    qtbot.mouseRelease(view, Qt.MouseButton.MiddleButton, pos=QPoint(130, 90))
+    moved = view.camera_state()
+    assert moved != framed
+    assert w.ctx.undo_stack.count() == 1 and w.ctx.undo_stack.isClean() and not w.is_modified()
+    assert "view3d.camera" not in w.doc.parameters
+    path = tmp_path / "cam.qtanim"
+    assert w.save_to(path)
+    assert w.ctx.undo_stack.count() == 1 and not w.is_modified()
+    import json
+
+    assert json.loads(path.read_text())["parameters"]["view3d.camera"] == moved
+    # Opening the project restores the camera instead of framing the scene again.
+    w.new_document()
+    view.render_image()
+    assert w.open_path(path)
+    view.render_image()
+    assert view.camera_state() == moved
+    assert not w.is_modified()
+    # A new 3D asset still frames itself.
+    w.ctx.push(add_character3d_command(w.doc, arm / "arm.skel", arm / "arm.skin", asset_id="arm2"))
+    import3d.show_character(w, "arm2")
+    assert view.camera_state() != moved

@@ -142,26 +142,11 @@ def csr_influences(indptr: np.ndarray, joints: np.ndarray, weights: np.ndarray) 
     return np.c_[first, counts].astype(np.float32), np.c_[joints, weights].astype(np.float32)
 
 
-def sparse_influences(weights: np.ndarray, threshold: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
-    """Per-vertex (first, count) and the flat (joint, weight) list of a dense (N, J) matrix.
-
-    Every non-zero weight is kept (MIT meshes have up to 13 per vertex), so skinning is exact.
-    """
-    w = np.asarray(weights, dtype=np.float64)
-    rows, cols = np.nonzero(np.abs(w) > threshold)
-    counts = np.bincount(rows, minlength=len(w))
-    first = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    pairs = np.c_[cols, w[rows, cols]].astype(np.float32)
-    if len(pairs) == 0:
-        pairs = np.zeros((1, 2), np.float32)
-    return np.c_[first, counts].astype(np.float32), pairs
-
-
 class SkinnedMesh(Mesh):
     """A mesh skinned in the vertex shader from its bind pose.
 
     ``influence`` is (N, 2): each vertex's first entry and count in ``pairs``, the flat
-    (joint, weight) list (see :func:`sparse_influences` / :func:`csr_influences`). Call
+    (joint, weight) list (see :func:`csr_influences`). Call
     :meth:`set_joint_matrices` with M_j = W_j·B_j⁻¹ (J, 4, 4) every frame: the only
     per-frame upload is J·64 bytes.
     """

@@ -354,15 +354,7 @@ class SceneRenderer:
         if mode >= 0 and opts.weight_asset is not None and opts.weight_asset != item.asset_id:
             mode = WEIGHTS_OFF
         p.set("u_weight_mode", mode)
-        if opts.wireframe:
-            GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
-            GL.glPolygonOffset(1.0, 1.0)
-        mesh.draw()
-        self._count(mesh)
-        if opts.wireframe:
-            GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
-            self._wire(mesh)
-        self._reset_state()
+        self._draw_surface(mesh, opts.wireframe)
 
     def skin_on_gpu(self, skin: SkinDraw, key: str = "_capture") -> tuple[np.ndarray, np.ndarray]:
         """Run the skinning vertex shader on every vertex and read back world positions and
@@ -401,6 +393,18 @@ class SceneRenderer:
         GL.glUseProgram(0)
         return arr[:, :3], arr[:, 3:]
 
+    def _draw_surface(self, mesh: Mesh, wireframe: bool) -> None:
+        if wireframe:
+            # Push the fill back so the wire drawn over it is not lost to z-fighting.
+            GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
+            GL.glPolygonOffset(1.0, 1.0)
+        mesh.draw()
+        self._count(mesh)
+        if wireframe:
+            GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
+            self._wire(mesh)
+        self._reset_state()
+
     def _wire(self, mesh: Mesh) -> None:
         p = self.program
         assert p is not None
@@ -432,15 +436,7 @@ class SceneRenderer:
             mesh.update(item.positions, item.normals)
         p.set("u_color", np.asarray(item.color, dtype=float))
         p.set("u_two_sided", 1)
-        if opts.wireframe:
-            GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
-            GL.glPolygonOffset(1.0, 1.0)
-        mesh.draw()
-        self._count(mesh)
-        if opts.wireframe:
-            GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
-            self._wire(mesh)
-        self._reset_state()
+        self._draw_surface(mesh, opts.wireframe)
         if item.spheres:
             models = []
             for centre, radius in item.spheres:

@@ -23,6 +23,7 @@ FloatArray = npt.NDArray[np.float64]
 KEY_SIZE = 7.0          # key square side, pixels
 HANDLE_LENGTH = 48.0    # tangent handle length, pixels
 HANDLE_SIZE = 7.0       # handle dot diameter, pixels
+HOVER_COLOUR = QColor(255, 255, 255)  # outline of the key or handle under the mouse
 
 _AXIS_COLOURS = {
     "x": QColor(232, 86, 86),
@@ -51,6 +52,10 @@ class KeyLayer:
     # Display slopes (display value per frame) of the selected keys, for their handles.
     slope_in: FloatArray = field(default_factory=lambda: np.zeros(0))
     slope_out: FloatArray = field(default_factory=lambda: np.zeros(0))
+    #: The key under the mouse (index into x / y), drawn larger and lighter.
+    hover_key: int | None = None
+    #: The handle under the mouse: (position among the selected keys, "in" or "out").
+    hover_handle: tuple[int, str] | None = None
 
 
 @dataclass
@@ -177,6 +182,22 @@ def _paint_keys(p: QPainter, tr: QTransform, layer: KeyLayer, colour: QColor) ->
         p.setBrush(QBrush(QColor(255, 190, 40)))
         p.drawRects([QRectF(x - half - 1, y - half - 1, KEY_SIZE + 2, KEY_SIZE + 2)
                      for x, y in zip(px[sel], py[sel])])
+    # Hover feedback (as Blender does): a lighter, larger key or handle under the mouse.
+    p.setPen(QPen(HOVER_COLOUR, 2.0))
+    if layer.hover_key is not None and layer.hover_key < len(px):
+        i = layer.hover_key
+        p.setBrush(QBrush(QColor(255, 225, 140) if sel[i] else colour.lighter(150)))
+        big = KEY_SIZE + 4
+        p.drawRect(QRectF(px[i] - big / 2, py[i] - big / 2, big, big))
+    if layer.hover_handle is not None and sel.any():
+        k, side = layer.hover_handle
+        sx, sy = px[sel], py[sel]
+        if k < len(sx):
+            ox, oy = handle_offsets(tr, (layer.slope_out if side == "out" else layer.slope_in)[k:k + 1])
+            sign = 1.0 if side == "out" else -1.0
+            c = QPointF(sx[k] + sign * ox[0], sy[k] + sign * oy[0])
+            p.setBrush(QBrush(QColor(255, 225, 140)))
+            p.drawEllipse(c, HANDLE_SIZE / 2 + 2, HANDLE_SIZE / 2 + 2)
 
 
 def pen(colour: QColor, width: float, dashed: bool = False, alpha: int = 255) -> QPen:

@@ -71,6 +71,10 @@ class ChannelTree(QWidget):
         if cids == self._cids:
             return
         hidden = {cid for cid, item in self._leaves.items() if item.checkState() == Qt.CheckState.Unchecked}
+        first_build = not self._groups
+        expanded = self.expanded_groups()
+        known = set(self._groups)
+        scroll = self.view.verticalScrollBar().value()
         self._updating = True
         try:
             self.model.clear()
@@ -97,8 +101,25 @@ class ChannelTree(QWidget):
         finally:
             self._updating = False
         self._cids = cids
-        self.view.expandToDepth(0)
+        if first_build:
+            self.view.expandToDepth(0)
+        else:
+            # Keep what the user opened; a new asset opens like the first time, new joints closed.
+            for path, item in self._groups.items():
+                if path in expanded or (path not in known and not path[1]):
+                    self.view.expand(self.proxy.mapFromSource(item.index()))
+            self.view.doItemsLayout()  # the scroll range follows the rows now, not at the next paint
+            self.view.verticalScrollBar().setValue(scroll)
         self.visibleChanged.emit(self.visible_channels())
+
+    def expanded_groups(self) -> set[tuple[str, str]]:
+        """``(asset, joint)`` of the open group rows (``joint`` is ``""`` for an asset row)."""
+        out = set()
+        for path, item in self._groups.items():
+            index = self.proxy.mapFromSource(item.index())
+            if index.isValid() and self.view.isExpanded(index):
+                out.add(path)
+        return out
 
     def _group(self, asset: str, joint: str) -> QStandardItem:
         item = self._groups.get((asset, joint))

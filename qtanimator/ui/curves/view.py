@@ -31,8 +31,8 @@ from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPen, QTransform
 from PySide6.QtWidgets import QGraphicsItem, QGraphicsRectItem, QWidget
 
 from qtanimator.core.channel import Channel, Key
-from qtanimator.document.commands import Command, DeleteKeys, InsertKey
-from qtanimator.document.curve_commands import MoveCurveKeys, SetKeySlopes
+from qtanimator.document.commands import Command, DeleteKeys, InsertKey, MoveKeys
+from qtanimator.document.curve_commands import SetKeySlopes
 from qtanimator.document.document import ChangeEvent, split_channel_id
 from qtanimator.ui.curves.items import (
     HANDLE_SIZE,
@@ -48,6 +48,7 @@ from qtanimator.ui.curves.sampling import SampleCache
 _gesture_ids = itertools.count(1)
 PICK_RADIUS = 7.0       # pixels: how close a click must be to a key or handle
 CURVE_PICK_RADIUS = 8.0  # pixels: how close to a curve Ctrl+click must be
+MOVE_HISTORY = 4096      # (before, after) pairs of dragged keys remembered per channel
 BACKGROUND = QColor(38, 40, 44)
 
 
@@ -62,6 +63,7 @@ class _Drag:
     side: str = ""
     start_scene: QPointF = field(default_factory=QPointF)
     additive: bool = False
+    moved: dict[str, list[tuple[tuple[float, float], tuple[float, float]]]] = field(default_factory=dict)
 
 
 class FrameLine(pg.InfiniteLine):
@@ -113,6 +115,11 @@ class CurveViewBox(pg.ViewBox):
     def mouseDragEvent(self, ev: Any, axis: int | None = None) -> None:
         if axis is None and self._view.drag_event(ev):
             return
+        if axis == 0 and ev.button() == Qt.MouseButton.LeftButton:
+            # A left drag forwarded by the time axis scrubs (middle / right drags still pan / zoom it).
+            ev.accept()
+            self._view.scrub(ev.scenePos(), finish=ev.isFinish())
+            return
         super().mouseDragEvent(ev, axis)
 
     def wheelEvent(self, ev: Any, axis: int | None = None) -> None:
@@ -139,6 +146,15 @@ class CurvePlot(pg.PlotWidget):
         # by the modifiers held when the button went down.
         self._view.press_modifiers = ev.modifiers()
         super().mousePressEvent(ev)
+
+    def mouseMoveEvent(self, ev: QMouseEvent) -> None:
+        super().mouseMoveEvent(ev)
+        if ev.buttons() == Qt.MouseButton.NoButton:
+            self._view.hover_at(self.mapToScene(ev.position().toPoint()))
+
+    def leaveEvent(self, ev: QEvent) -> None:
+        self._view.hover_at(None)
+        super().leaveEvent(ev)
 
     def event(self, ev: QEvent) -> bool:
         # Keys the curve editor uses win over window shortcuts while the plot has focus.
@@ -181,6 +197,13 @@ class CurveView(QObject):
         self._live: set[str] = set()
         self._syncing_frame = False
         self.press_modifiers = Qt.KeyboardModifier.NoModifier
+        # The channel object each selection's indices refer to, and (time, value) pairs of
+        # keys moved by drags, so that the selection follows the same keys through undo / redo.
+        self._selection_base: dict[str, Channel] = {}
+        self._moves: dict[str, list[tuple[tuple[float, float], tuple[float, float]]]] = {}
+        #: What the mouse is over: ("key", cid, index), ("handle", cid, index, side) or None.
+        self.hover: tuple[Any, ...] | None = None
+        self._scrubbing = False
 
         self.widget = CurvePlot(self)
         self.plot_item = self.widget.getPlotItem()
@@ -314,11 +337,64 @@ class CurveView(QObject):
             cid = event.key
             if cid not in self.doc.channels:
                 self.cache.drop(cid)
+            if self._drag is None:
+                self._map_selection(cid)
             self._prune_selection()
             if cid in self.visible:
                 self.refresh_channel(cid)
         elif event.kind == "parameter" and event.key == "fps":
             self.refresh_all()
+
+    def _map_selection(self, cid: str) -> None:
+        """Channel ``cid`` changed (an undo, another editor): keep its selected keys selected.
+
+        A key is found again by its time and value; a key moved by a drag (or put back by
+        undoing one) by the time and value it had at the other end of the move; a key whose
+        value alone changed by its time. Keys that cannot be found are dropped from the
+        selection.
+        """
+        old = self._selection_base.get(cid)
+        new = self.doc.channels.get(cid)
+        idx = self.selection.get(cid)
+        if old is None or new is None or not idx or old is new:
+            return
+        where = {(k.time, k.value): j for j, k in enumerate(new.keys)}
+        at_time = {k.time: j for j, k in enumerate(new.keys)}
+        moves = self._moves.get(cid, [])
+        mapped: set[int] = set()
+        active = None
+        for i in sorted(idx):
+            if i >= len(old.keys):
+                continue
+            tv = (old.keys[i].time, old.keys[i].value)
+            j = where.get(tv)
+            if j is None:
+                for a, b in reversed(moves):
+                    if b == tv and a in where:
+                        j = where[a]
+                        break
+                    if a == tv and b in where:
+                        j = where[b]
+                        break
+            if j is None:
+                j = at_time.get(tv[0])  # same time, new value (a typed value, a slider)
+            if j is not None:
+                mapped.add(j)
+                if self.active == (cid, i):
+                    active = (cid, j)
+        if mapped:
+            self.selection[cid] = mapped
+        else:
+            del self.selection[cid]
+        self._selection_base[cid] = new
+        if self.active is not None and self.active[0] == cid:
+            self.active = active or self._first_selected()
+        self._update_live()
+        self.keySelectionChanged.emit()
+
+    def _note_selection_base(self) -> None:
+        self._selection_base = {cid: self.doc.channels[cid] for cid, idx in self.selection.items()
+                                if idx and cid in self.doc.channels}
 
     def _prune_selection(self) -> None:
         changed = False
@@ -345,6 +421,9 @@ class CurveView(QObject):
         """The document was replaced: forget caches and selection."""
         self.cache.clear()
         self.selection.clear()
+        self._selection_base.clear()
+        self._moves.clear()
+        self.hover = None
         self.active = None
         self._drag = None
         self._frozen_norm.clear()
@@ -371,6 +450,12 @@ class CurveView(QObject):
                 mask = np.zeros(len(ch.keys), dtype=bool)
                 mask[sel_idx] = True
                 layer = KeyLayer(ch.times * fps, (ch.values - off) * scale, mask)
+                hover = self.hover
+                if hover is not None and hover[1] == cid and hover[2] < len(ch.keys):
+                    if hover[0] == "key":
+                        layer.hover_key = hover[2]
+                    elif hover[2] in sel_idx:
+                        layer.hover_handle = (sel_idx.index(hover[2]), hover[3])
                 if sel_idx:
                     s_in, s_out = ch.slopes()
                     k = scale / fps
@@ -465,6 +550,7 @@ class CurveView(QObject):
             self.active = active
         elif self.active is None or self.active[1] not in self.selection.get(self.active[0], set()):
             self.active = self._first_selected()
+        self._note_selection_base()
         self._update_live()
         self.keySelectionChanged.emit()
 
@@ -483,6 +569,7 @@ class CurveView(QObject):
         if not sel:
             return
         self.selection.clear()
+        self._selection_base.clear()
         self.active = None
         self.push(DeleteKeys(self.doc, sel))
         self.keySelectionChanged.emit()
@@ -571,6 +658,40 @@ class CurveView(QObject):
             self.frame_line.setValue(frame)
             return
         self.ctx.set_frame(frame)
+
+    # ---------------------------------------------------------------- hover
+    def hover_at(self, scene: QPointF | None) -> None:
+        """Highlight the key or handle under the mouse and show a cursor that says what a
+        drag will do there: move (keys), point (handles), arrow elsewhere."""
+        hit: tuple[Any, ...] | None = None
+        if scene is not None and not self.dragging and self.vb.sceneBoundingRect().contains(scene):
+            handle = self.handle_at(scene)
+            if handle is not None:
+                hit = ("handle", *handle)
+            else:
+                key = self.key_at(scene)
+                if key is not None:
+                    hit = ("key", *key)
+        if hit == self.hover:
+            return
+        old, self.hover = self.hover, hit
+        shape = {None: None, "key": Qt.CursorShape.SizeAllCursor, "handle": Qt.CursorShape.PointingHandCursor}[
+            hit[0] if hit else None]
+        viewport = self.widget.viewport()
+        if shape is None:
+            viewport.unsetCursor()
+        else:
+            viewport.setCursor(shape)
+        for h in (old, hit):
+            if h is not None:
+                (self.live_layer if h[1] in self._live else self.static_layer).update()
+
+    def scrub(self, scene: QPointF, finish: bool = False) -> None:
+        """A drag along the time axis: the current frame follows the mouse (whole frames)."""
+        frame = float(round(self.vb.mapSceneToView(scene).x()))
+        self._scrubbing = not finish
+        if frame != self.ctx.frame:
+            self.ctx.set_frame(frame)
 
     # ------------------------------------------------------------- gestures
     def click(self, scene: QPointF, mods: Qt.KeyboardModifier) -> None:
@@ -677,7 +798,7 @@ class CurveView(QObject):
         if not drag.pushed and dt == 0.0 and dy == 0.0:
             return
         try:
-            cmd = MoveCurveKeys(drag.base, drag.selection, dt, dv, gesture=drag.gesture)
+            cmd = MoveKeys(drag.base, drag.selection, dt, dv, gesture=drag.gesture)
         except ValueError:
             return  # a key would land on another key's time: keep the last valid position
         self.push(cmd)
@@ -700,7 +821,7 @@ class CurveView(QObject):
             return
         p = pivot / self.fps
         try:
-            cmd = MoveCurveKeys(drag.base, drag.selection, 0.0, 0.0, gesture=drag.gesture,
+            cmd = MoveKeys(drag.base, drag.selection, 0.0, 0.0, gesture=drag.gesture,
                                 text="Scale Keys", time_scale=(p, factor))
         except ValueError:
             return
@@ -712,18 +833,24 @@ class CurveView(QObject):
         """Keys may pass others while moving: find the moved keys' new indices."""
         new_sel: dict[str, set[int]] = {}
         active = None
+        drag.moved = {}
         for cid, idx in drag.selection.items():
             ch = self.doc.channels[cid]
             times = ch.times
             found = set()
+            pairs = []
             for i in idx:
                 t = new_time(drag.base[cid].keys[i].time)
                 j = int(np.argmin(np.abs(times - t)))
                 found.add(j)
+                a, b = drag.base[cid].keys[i], ch.keys[j]
+                pairs.append(((a.time, a.value), (b.time, b.value)))
                 if drag.anchor == (cid, i):
                     active = (cid, j)
             new_sel[cid] = found
+            drag.moved[cid] = pairs
         self.selection = new_sel
+        self._note_selection_base()
         self.active = active or self._first_selected()
         self._update_live()
         self.keySelectionChanged.emit()
@@ -784,9 +911,15 @@ class CurveView(QObject):
             self._frozen_norm.clear()
             if drag.pushed and all(self.doc.channels.get(c) == ch for c, ch in drag.base.items()):
                 self._drop_gesture(drag)  # back where it started: no undo step
+            else:
+                for cid, pairs in drag.moved.items():
+                    history = self._moves.setdefault(cid, [])
+                    history.extend((a, b) for a, b in pairs if a != b)
+                    del history[:-MOVE_HISTORY]
             self.refresh_all()
         elif drag.kind == "handle":
             self._frozen_norm.clear()
+            self._note_selection_base()
             self.refresh_all()
 
     @property
@@ -802,6 +935,8 @@ class CurveView(QObject):
             self._drop_gesture(drag)
             if drag.kind != "handle":
                 self.set_selection(drag.selection, drag.anchor)
+            else:
+                self._note_selection_base()
         self.box.hide()
         self._frozen_norm.clear()
         self._drag = _Drag("aborted")
