@@ -96,7 +96,7 @@ def build() -> Document:
     add_character3d_command(doc, arm / "arm.skel", arm / "arm.skin", arm / "arm_wave.anim", asset_id="arm").do(doc)
     add_cloth_command(doc, flag_params(), asset_id="flag").do(doc)
     # The 3D view opens on the flag and the arm (view state, as the program saves it).
-    doc.parameters["view3d.camera"] = dict(VIEW3D_CAMERA)
+    doc.set_view_state("view3d.camera", dict(VIEW3D_CAMERA))
     return doc
 
 

@@ -88,6 +88,9 @@ class Document:
         self.channels: dict[str, Channel] = {}
         self.parameters: dict[str, Any] = dict(PROJECT_DEFAULTS)
         self.runtime: dict[str, Any] = {}
+        #: View state such as the 3D camera: saved with the project, never an edit (no
+        #: command, no undo step, not part of :meth:`state`). See :meth:`set_view_state`.
+        self.view_state: dict[str, Any] = {}
         self.path: str | None = None
         self._listeners: list[Listener] = []
 
@@ -169,12 +172,17 @@ class Document:
                 self.runtime[asset_id] = runtime
         self.emit(ChangeEvent("asset", asset_id))
 
+    def set_view_state(self, key: str, value: Any) -> None:
+        """Remember how an editor looks at the document (camera, zoom). Not an edit."""
+        self.view_state[key] = value
+
     def replace_all(self, other: Document) -> None:
         """Take over another document's content (used by File > Open and New)."""
         self.assets = other.assets
         self.channels = other.channels
         self.parameters = other.parameters
         self.runtime = other.runtime
+        self.view_state = other.view_state
         self.path = other.path
         self.emit(ChangeEvent("reset"))
 

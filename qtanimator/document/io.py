@@ -14,6 +14,7 @@ from qtanimator.formats.project import AssetRecord, ProjectData, load_project, s
 def to_project_data(doc: Document) -> ProjectData:
     return ProjectData(
         parameters=dict(doc.parameters),
+        view=dict(doc.view_state),
         assets=[AssetRecord(a.id, a.kind, a.source, a.properties) for a in doc.assets.values()],
         channels=dict(doc.channels),
     )
@@ -23,6 +24,7 @@ def document_from_project_data(data: ProjectData) -> Document:
     """Build a document and load every asset's source (FormatError if one fails)."""
     doc = Document()
     doc.parameters = {**PROJECT_DEFAULTS, **data.parameters}
+    doc.view_state = dict(data.view)
     for rec in data.assets:
         asset = Asset(rec.id, rec.kind, rec.source, dict(rec.properties))
         doc.assets[asset.id] = asset

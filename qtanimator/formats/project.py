@@ -49,6 +49,8 @@ class ProjectData:
     parameters: dict[str, Any] = field(default_factory=dict)
     assets: list[AssetRecord] = field(default_factory=list)
     channels: dict[str, Channel] = field(default_factory=dict)
+    #: View state (e.g. the 3D camera): saved with the project, but not authored content.
+    view: dict[str, Any] = field(default_factory=dict)
 
 
 def project_to_json(data: ProjectData, base_dir: str | os.PathLike[str]) -> str:
@@ -68,6 +70,8 @@ def project_to_json(data: ProjectData, base_dir: str | os.PathLike[str]) -> str:
         "assets": assets,
         "channels": {cid: ch.to_dict() for cid, ch in data.channels.items()},
     }
+    if data.view:
+        doc["view"] = data.view
     try:
         return json.dumps(doc, indent=2, allow_nan=False, ensure_ascii=False) + "\n"
     except (TypeError, ValueError) as exc:  # NaN, infinity or a non-JSON object in the parameters
@@ -134,6 +138,11 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
         raise FormatError("\"parameters\" must be an object.", p)
     _check_parameters(params, p)
     data.parameters = params
+    view = obj.get("view", {})
+    if not isinstance(view, dict):
+        raise FormatError("\"view\" must be an object.", p)
+    _check_parameters(view, p)
+    data.view = view
     assets = obj.get("assets", [])
     if not isinstance(assets, list):
         raise FormatError("\"assets\" must be a list.", p)

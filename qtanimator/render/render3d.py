@@ -125,7 +125,7 @@ class OffscreenGL:
 def default_camera(items: list[SceneItem], doc: Any = None) -> OrbitCamera:
     """A camera framing the scene (or the one stored in the document's ``view3d.camera``)."""
     cam = OrbitCamera()
-    stored = None if doc is None else doc.parameters.get("view3d.camera")
+    stored = None if doc is None else doc.view_state.get("view3d.camera")
     if isinstance(stored, dict):
         cam.azimuth = float(stored.get("azimuth", cam.azimuth))
         cam.inclination = float(stored.get("inclination", cam.inclination))

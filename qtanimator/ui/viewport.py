@@ -287,7 +287,7 @@ class Viewport3D(QOpenGLWidget):
     def restore_camera(self) -> bool:
         """Take the camera stored in the document (``view3d.camera``); without one (or with
         an unreadable one) the view frames the scene at its next paint. True if restored."""
-        stored = self.ctx.doc.parameters.get(CAMERA_PARAMETER)
+        stored = self.ctx.doc.view_state.get(CAMERA_PARAMETER)
         camera = OrbitCamera()
         try:
             if not isinstance(stored, dict):
@@ -317,17 +317,14 @@ class Viewport3D(QOpenGLWidget):
                 "target": [float(v) for v in np.asarray(c.target, dtype=float)], "fov_y": float(c.fov_y)}
 
     def store_camera(self) -> None:
-        """Save hook: put the camera into the document's ``view3d.camera`` parameter.
+        """Save hook: remember the camera in the document's view state (``view3d.camera``).
 
-        Camera moves are view state, not edits: this writes the parameter directly (no
-        command, no undo step, the document is not marked modified). Only a camera that has
-        framed or shown a scene is stored; an untouched document keeps what it had.
+        Camera moves are view state, not edits: no command, no undo step, the document is
+        not marked modified. Only a camera that has framed or shown a scene is stored; an
+        untouched document keeps what it had.
         """
-        if not self._framed_once:
-            return
-        state = self.camera_state()
-        if self.ctx.doc.parameters.get(CAMERA_PARAMETER) != state:
-            self.ctx.doc.parameters[CAMERA_PARAMETER] = state
+        if self._framed_once:
+            self.ctx.doc.set_view_state(CAMERA_PARAMETER, self.camera_state())
 
     def frame_bounds(self, bounds: tuple[np.ndarray, np.ndarray]) -> None:
         """Point the camera at a box (a new 3D asset frames itself this way)."""

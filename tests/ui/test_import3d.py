@@ -105,9 +105,10 @@ def test_save_and_reopen_keeps_imported_assets(window, shared_data, tmp_path, di
         window.ctx.select("", "")
         assert window.open_path(shared_data / rel), dialog_log
     project = tmp_path / "scene.qtanim"
+    state = window.doc.state()
     assert window.save_to(project)
-    state = window.doc.state()  # saving stores the 3D camera (view state) in the document
-    assert "view3d.camera" in window.doc.parameters
+    assert window.doc.state() == state  # saving stores only view state (the 3D camera)
+    assert "view3d.camera" in window.doc.view_state
     assert window.open_path(project)
     assert window.doc.state() == state
     for aid, asset in window.doc.assets.items():

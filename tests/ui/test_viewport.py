@@ -435,13 +435,13 @@ def test_camera_is_saved_with_the_project_without_an_undo_step_and_restored(qtbo
     moved = view.camera_state()
     assert moved != framed
     assert w.ctx.undo_stack.count() == 1 and w.ctx.undo_stack.isClean() and not w.is_modified()
-    assert "view3d.camera" not in w.doc.parameters
+    assert "view3d.camera" not in w.doc.view_state
     path = tmp_path / "cam.qtanim"
     assert w.save_to(path)
     assert w.ctx.undo_stack.count() == 1 and not w.is_modified()
     import json
 
-    assert json.loads(path.read_text())["parameters"]["view3d.camera"] == moved
+    assert json.loads(path.read_text())["view"]["view3d.camera"] == moved
     # Opening the project restores the camera instead of framing the scene again.
     w.new_document()
     view.render_image()
