@@ -304,3 +304,20 @@ def test_format_error_carries_where_and_pickles():
     assert (back.message, back.path, back.line, back.column) == ("expected a number.", "/data/wasp.skel", 12, 5)
     assert str(back) == str(err)
     assert str(FormatError("plain")) == "plain"
+
+
+def test_view_state_round_trips_apart_from_authored_state(tmp_path):
+    from qtanimator.document import Document, open_document, save_document
+
+    doc = Document()
+    doc.set_view_state("view3d.camera", {"azimuth": 30.0, "target": [0.0, 1.0, 0.0]})
+    authored = doc.state()
+    path = tmp_path / "v.qtanim"
+    save_document(doc, path)
+    again = open_document(path)
+    assert again.view_state == {"view3d.camera": {"azimuth": 30.0, "target": [0.0, 1.0, 0.0]}}
+    assert again.state() == authored
+    text = path.read_text()
+    path.write_text(text.replace('"view": {', '"view": [{').replace("}\n  }\n}", "}\n  }]\n}"))
+    with pytest.raises(FormatError, match='"view" must be an object'):
+        open_document(path)
