@@ -8,14 +8,13 @@ marked ``gl`` are skipped with the reason.
 
 from __future__ import annotations
 
-import atexit
 import os
-import shutil
-import subprocess
 import tempfile
 from pathlib import Path
 
 import pytest
+
+from qtanimator.render.xvfb import start_private_xvfb
 
 REPO = Path(__file__).resolve().parents[1]
 SHARED_DATA = (REPO / ".." / "shared" / "data").resolve()
@@ -29,29 +28,11 @@ def _start_xvfb() -> str | None:
     if os.environ.get("QTANIMATOR_TEST_NO_XVFB"):
         _xvfb_reason = "QTANIMATOR_TEST_NO_XVFB is set"
         return None
-    exe = shutil.which("Xvfb")
-    if exe is None:
-        _xvfb_reason = "Xvfb is not installed (apt-get install xvfb)"
-        return None
-    read_fd, write_fd = os.pipe()
     try:
-        proc = subprocess.Popen(
-            [exe, "-displayfd", str(write_fd), "-screen", "0", "1920x1080x24", "-nolisten", "tcp",
-             "+extension", "GLX", "-noreset"],
-            pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
-        )
+        return start_private_xvfb("1920x1080x24")
     except OSError as exc:
-        _xvfb_reason = f"Xvfb did not start: {exc}"
+        _xvfb_reason = str(exc)
         return None
-    os.close(write_fd)
-    with os.fdopen(read_fd) as fh:
-        number = fh.readline().strip()
-    if not number:
-        proc.kill()
-        _xvfb_reason = "Xvfb started but reported no display"
-        return None
-    atexit.register(proc.terminate)
-    return f":{number}"
 
 
 def _configure_qt() -> None:

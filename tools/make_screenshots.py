@@ -26,7 +26,6 @@ from __future__ import annotations
 import argparse
 import os
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -42,23 +41,6 @@ SHOTS = ("main_window", "curve_editor", "viewport_3d", "joint_tree", "pendulum_p
 
 
 # ------------------------------------------------------------------ display
-def start_xvfb() -> tuple[subprocess.Popen[bytes], str]:
-    """A private Xvfb on a free display number (``-displayfd`` lets the server pick one)."""
-    exe = shutil.which("Xvfb")
-    if exe is None:
-        sys.exit("make_screenshots: Xvfb is needed (apt-get install xvfb)")
-    r, w = os.pipe()
-    proc = subprocess.Popen([exe, "-displayfd", str(w), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
-                            pass_fds=(w,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    os.close(w)
-    with os.fdopen(r) as f:
-        number = f.readline().strip()
-    if not number:
-        proc.terminate()
-        sys.exit("make_screenshots: Xvfb did not start")
-    return proc, f":{number}"
-
-
 # ------------------------------------------------------------------ helpers
 def settle(app, seconds: float = 0.3) -> None:  # type: ignore[no-untyped-def]
     """Let Qt process events (and GL paint) for a while."""
@@ -317,10 +299,13 @@ def main(argv: list[str] | None = None) -> int:
     ns = ap.parse_args(argv)
     ns.out.mkdir(parents=True, exist_ok=True)
 
-    xvfb = None
     if not ns.keep_display:
-        xvfb, display = start_xvfb()
-        os.environ["DISPLAY"] = display
+        from qtanimator.render.xvfb import start_private_xvfb  # stopped when this script exits
+
+        try:
+            os.environ["DISPLAY"] = start_private_xvfb("1600x1000x24")
+        except OSError as exc:
+            sys.exit(f"make_screenshots: {exc}")
     os.environ["QT_QPA_PLATFORM"] = "xcb"
     settings_dir = tempfile.mkdtemp(prefix="qtanimator-shots-")
     os.environ["QTANIMATOR_SETTINGS_DIR"] = settings_dir
@@ -338,9 +323,6 @@ def main(argv: list[str] | None = None) -> int:
         settle(shooter.app, 0.2)
     finally:
         shutil.rmtree(settings_dir, ignore_errors=True)
-        if xvfb is not None:
-            xvfb.terminate()
-            xvfb.wait(5)
     return 0
 
 

@@ -10,11 +10,8 @@ there); Qt's ``offscreen`` platform has no OpenGL.
 
 from __future__ import annotations
 
-import atexit
 import copy
 import os
-import shutil
-import subprocess
 from collections.abc import Iterable, Iterator
 from typing import Any
 
@@ -28,32 +25,11 @@ from qtanimator.render.gl.lights import ambient_of, lights_of
 from qtanimator.render.gl.renderer import SceneItem, SceneRenderer, ViewOptions, grid_scale_for
 from qtanimator.render.painter2d import image_to_array
 from qtanimator.render.scene3d import scene_bounds, scene_items
+from qtanimator.render.xvfb import start_private_xvfb
 
 
 class GLUnavailableError(OSError):
     """No OpenGL 3.3 context can be made here; the message says why."""
-
-
-_xvfb: subprocess.Popen[bytes] | None = None
-
-
-def _start_private_xvfb() -> str:
-    global _xvfb
-    exe = shutil.which("Xvfb")
-    if exe is None:
-        raise GLUnavailableError("3D rendering needs a display or Xvfb (apt-get install xvfb)")
-    read_fd, write_fd = os.pipe()
-    _xvfb = subprocess.Popen([exe, "-displayfd", str(write_fd), "-screen", "0", "640x480x24",
-                              "-nolisten", "tcp", "+extension", "GLX", "-noreset"],
-                             pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    os.close(write_fd)
-    with os.fdopen(read_fd) as fh:
-        number = fh.readline().strip()
-    if not number:
-        _xvfb.kill()
-        raise GLUnavailableError("Xvfb started but reported no display")
-    atexit.register(_xvfb.terminate)
-    return f":{number}"
 
 
 def ensure_gui_application() -> QGuiApplication:
@@ -64,7 +40,10 @@ def ensure_gui_application() -> QGuiApplication:
     platform = os.environ.get("QT_QPA_PLATFORM", "")
     has_display = bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
     if platform in ("", "offscreen", "minimal") and not has_display:
-        os.environ["DISPLAY"] = _start_private_xvfb()
+        try:
+            os.environ["DISPLAY"] = start_private_xvfb("640x480x24")
+        except OSError as exc:
+            raise GLUnavailableError(f"3D rendering needs a display: {exc}") from exc
         os.environ["QT_QPA_PLATFORM"] = "xcb"
     return QGuiApplication([])
 
