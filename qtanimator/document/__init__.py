@@ -17,11 +17,11 @@ from qtanimator.document.commands import (
     SetTangents,
     UndoStack,
 )
-from qtanimator.document.document import Asset, ChangeEvent, Document, channel_id, split_channel_id
+from qtanimator.document.document import Asset, Document, DocumentChange, channel_id, split_channel_id
 from qtanimator.document.io import open_document, save_document
 
 __all__ = [
-    "AddAsset", "Asset", "ChangeEvent", "Command", "DeleteKeys", "Document", "EditKey",
+    "AddAsset", "Asset", "Command", "DeleteKeys", "Document", "DocumentChange", "EditKey",
     "InsertKey", "Macro", "MoveKeys", "RemoveAsset", "SetAssetProperty", "SetChannels",
     "SetExtrapolation", "SetKeys", "SetParameter", "SetTangents", "UndoStack", "channel_id",
     "open_document", "save_document", "split_channel_id",

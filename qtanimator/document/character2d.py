@@ -31,14 +31,32 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Key
-from qtanimator.core.ik import solve_ik
+from qtanimator.core.ik import gradient_descent_step, solve_ik
 from qtanimator.core.pendulum import PRESETS, PendulumParams, PendulumSystem
 from qtanimator.core.rig2d import Character, Pose
 from qtanimator.document.commands import AddAsset, Command, DeleteKeys, Macro, SetKeys, SetParameter
-from qtanimator.document.document import Asset, ChangeEvent, Document, channel_id, split_channel_id
+from qtanimator.document.document import Asset, Document, DocumentChange, channel_id, split_channel_id
 
 ASSET_KIND = "character2d"
 KEY_ALL_PARAMETER = "animation.key_all"
+
+#: IK solver settings: document parameters with their defaults (edited in the properties
+#: dock). ``ik.solver`` is "dls" (damped least squares, limits respected) or "handout" (the
+#: course handout's gradient descent); ``ik.gradient_arrow_scale`` only scales the debug arrows.
+IK_DEFAULTS: dict[str, Any] = {
+    "ik.solver": "dls",
+    "ik.freeze_root": True,
+    "ik.max_iterations": 100,
+    "ik.damping": 1e-3,
+    "ik.handout_step": 1e-6,
+    "ik.handout_iterations": 10,
+    "ik.gradient_arrow_scale": 0.1,
+}
+
+
+def ik_setting(doc: Document, name: str) -> Any:
+    """One IK setting of the document (its default when unset)."""
+    return doc.parameter(name, IK_DEFAULTS[name])
 DELETE_TOLERANCE_FRAMES = 0.1
 FloatArray = npt.NDArray[np.float64]
 
@@ -208,15 +226,24 @@ def move_character(doc: Document, asset_id: str, xy: npt.ArrayLike, time: float,
 def ik_drag(doc: Document, asset_id: str, joint_index: int, local_point: npt.ArrayLike,
             target: npt.ArrayLike, time: float, gesture: Hashable | None = None,
             limits: npt.ArrayLike | None = None) -> Command:
-    """Solve IK from the pose at ``time`` and key the keyframed joints that moved."""
+    """Solve IK from the pose at ``time`` with the document's IK settings (``IK_DEFAULTS``)
+    and key the keyframed joints that moved (every joint in key-all mode)."""
     ch = character(doc, asset_id)
     if ch.dynamic[ch.ancestors(joint_index)].any():
         before = joint_angles(doc, asset_id, time)
     else:
         # The chain's pose needs only its own (keyframed) angles: no simulation to run.
         before = keyframed_angles(doc, asset_id, time)
-    after = solve_ik(ch, before, translation(doc, asset_id, time), joint_index, local_point, target,
-                     limits=limits)
+    position = translation(doc, asset_id, time)
+    if str(ik_setting(doc, "ik.solver")) == "handout":
+        after = gradient_descent_step(ch, before, position, joint_index, local_point, target,
+                                      step=float(ik_setting(doc, "ik.handout_step")),
+                                      iterations=int(ik_setting(doc, "ik.handout_iterations")))
+    else:
+        after = solve_ik(ch, before, position, joint_index, local_point, target, limits=limits,
+                         freeze_root=bool(ik_setting(doc, "ik.freeze_root")),
+                         max_iterations=int(ik_setting(doc, "ik.max_iterations")),
+                         damping=float(ik_setting(doc, "ik.damping")))
     keys = {angle_channel_id(asset_id, j.name): _key(time, after[k])
             for k, j in enumerate(ch.joints)
             if not j.is_dynamic and abs(after[k] - before[k]) > 1e-12}
@@ -333,22 +360,23 @@ class PendulumCache:
         doc.subscribe(self._on_change)
 
     # ---- invalidation
-    def _on_change(self, ev: ChangeEvent) -> None:
+    def _on_change(self, change: DocumentChange) -> None:
         doc = self._doc()
         if doc is None:
             return
-        if ev.kind == "reset":
+        if change.reset:
             self._sims.clear()
-        elif ev.kind == "asset":
-            self._sims.pop(ev.key, None)
-        elif ev.kind == "parameter":
-            if ev.key in ("fps", "frame_start") or ev.key.startswith("simulation."):
+            return
+        for asset_id in change.assets:
+            self._sims.pop(asset_id, None)
+        for path in change.parameters:
+            if path in ("fps", "frame_start") or path.startswith("simulation."):
                 self._sims.clear()
-            elif ".pendulum." in ev.key:
-                self._sims.pop(ev.key.split(".pendulum.", 1)[0], None)
-        elif ev.kind == "channel":
-            asset = ev.key.split("/", 1)[0]
-            self.invalidate(asset, ev.time_from)
+            elif ".pendulum." in path:
+                self._sims.pop(path.split(".pendulum.", 1)[0], None)
+        for asset_id in change.channel_assets():
+            # One invalidation per asset and command, from its earliest edited time.
+            self.invalidate(asset_id, change.channel_time_from(asset_id))
 
     def invalidate(self, asset_id: str | None = None, time_from: float = -math.inf) -> None:
         """Drop the cached frames whose state depends on inputs at or after ``time_from``

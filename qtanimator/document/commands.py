@@ -399,7 +399,8 @@ class UndoStack:
         """Do ``cmd`` and record it. Like QUndoStack with obsolete commands, a command
         that changes nothing is not recorded, and a gesture merged back to where it
         started disappears from the history."""
-        cmd.do(self.doc)
+        with self.doc.batch():
+            cmd.do(self.doc)
         self.undone.clear()
         if self.done and self.done[-1].merge(cmd):
             if self.done[-1].is_noop():
@@ -408,11 +409,19 @@ class UndoStack:
         if not cmd.is_noop():
             self.done.append(cmd)
 
+    def record(self, cmd: Command) -> None:
+        """Record a command that is already done as one step: the ``record`` of a
+        :class:`qtanimator.document.gesture.Gesture` committed without Qt."""
+        self.undone.clear()
+        if not cmd.is_noop():
+            self.done.append(cmd)
+
     def undo(self) -> bool:
         if not self.done:
             return False
         cmd = self.done.pop()
-        cmd.undo(self.doc)
+        with self.doc.batch():
+            cmd.undo(self.doc)
         self.undone.append(cmd)
         return True
 
@@ -420,6 +429,7 @@ class UndoStack:
         if not self.undone:
             return False
         cmd = self.undone.pop()
-        cmd.do(self.doc)
+        with self.doc.batch():
+            cmd.do(self.doc)
         self.done.append(cmd)
         return True

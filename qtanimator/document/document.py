@@ -21,8 +21,10 @@ parameter
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass, field
+from types import MappingProxyType
 from typing import Any
 
 from qtanimator.core.channel import Channel
@@ -64,20 +66,68 @@ class Asset:
         return Asset(self.id, self.kind, self.source, _deep_copy(self.properties))
 
 
-@dataclass(frozen=True)
-class ChangeEvent:
-    """What changed. ``kind`` is 'channel', 'parameter', 'asset' or 'reset'.
+_NO_CHANNELS: Mapping[str, float] = MappingProxyType({})
 
-    For channels, ``time_from`` is the earliest time whose evaluation may differ (caches
-    keep what lies before it); ``-inf`` means everything.
+
+@dataclass(frozen=True)
+class DocumentChange:
+    """Everything one command (or one batch of edits) changed: one notification per command.
+
+    ``channels`` maps each changed channel id to the earliest time whose evaluation may
+    differ (caches keep what lies before it; ``-inf`` means everything, ``+inf`` that the
+    channel was set to an equal value). ``parameters`` and ``assets`` are the changed
+    parameter paths and asset ids; ``reset`` says the whole document was replaced.
     """
 
-    kind: str
-    key: str = ""
-    time_from: float = -math.inf
+    channels: Mapping[str, float] = field(default_factory=lambda: _NO_CHANNELS)
+    parameters: frozenset[str] = frozenset()
+    assets: frozenset[str] = frozenset()
+    reset: bool = False
+
+    @property
+    def time_from(self) -> float:
+        """The earliest affected time over every changed channel (+inf without channels)."""
+        return min(self.channels.values(), default=math.inf)
+
+    def channel_assets(self) -> frozenset[str]:
+        """The ids of the assets whose channels changed."""
+        return frozenset(cid.split("/", 1)[0] for cid in self.channels)
+
+    def touches_asset(self, asset_id: str) -> bool:
+        """True when the asset itself or any of its channels changed (or on reset)."""
+        return self.reset or asset_id in self.assets or asset_id in self.channel_assets()
+
+    def channel_time_from(self, asset_id: str) -> float:
+        """The earliest affected time among one asset's changed channels (+inf if none)."""
+        prefix = asset_id + "/"
+        return min((t for cid, t in self.channels.items() if cid.startswith(prefix)), default=math.inf)
+
+    def merged(self, other: DocumentChange) -> DocumentChange:
+        """The union of two changes (what a view sees when it catches up on both)."""
+        channels = dict(self.channels)
+        for cid, t in other.channels.items():
+            channels[cid] = min(t, channels.get(cid, math.inf))
+        return DocumentChange(MappingProxyType(channels), self.parameters | other.parameters,
+                              self.assets | other.assets, self.reset or other.reset)
+
+    def __bool__(self) -> bool:
+        return bool(self.channels or self.parameters or self.assets or self.reset)
 
 
-Listener = Callable[[ChangeEvent], None]
+class _PendingChange:
+    """What a batch has changed so far (see :meth:`Document.batch`)."""
+
+    def __init__(self) -> None:
+        self.channels: dict[str, float] = {}
+        self.parameters: set[str] = set()
+        self.assets: set[str] = set()
+
+    def freeze(self) -> DocumentChange:
+        return DocumentChange(MappingProxyType(self.channels), frozenset(self.parameters),
+                              frozenset(self.assets))
+
+
+Listener = Callable[[DocumentChange], None]
 
 
 class Document:
@@ -93,6 +143,8 @@ class Document:
         self.view_state: dict[str, Any] = {}
         self.path: str | None = None
         self._listeners: list[Listener] = []
+        self._pending: _PendingChange | None = None
+        self._batch_depth = 0
 
     # ----------------------------------------------------------- notification
     def subscribe(self, listener: Listener) -> None:
@@ -102,9 +154,40 @@ class Document:
         if listener in self._listeners:
             self._listeners.remove(listener)
 
-    def emit(self, event: ChangeEvent) -> None:
+    def emit(self, change: DocumentChange) -> None:
+        """Tell every listener about ``change`` (inside a batch: fold it into the batch)."""
+        if self._pending is not None and not change.reset:
+            self._record(change)
+            return
         for listener in list(self._listeners):
-            listener(event)
+            listener(change)
+
+    @contextmanager
+    def batch(self) -> Iterator[None]:
+        """Fold every change made inside into one notification, sent when the outermost
+        batch ends (also when it ends with an exception: what was changed is announced).
+        Commands run inside a batch, so a command announces one change however many
+        channels it touches."""
+        self._batch_depth += 1
+        if self._pending is None:
+            self._pending = _PendingChange()
+        try:
+            yield
+        finally:
+            self._batch_depth -= 1
+            if self._batch_depth == 0:
+                pending, self._pending = self._pending, None
+                change = pending.freeze() if pending is not None else DocumentChange()
+                if change:
+                    self.emit(change)
+
+    def _record(self, change: DocumentChange) -> None:
+        pending = self._pending
+        assert pending is not None
+        for cid, t in change.channels.items():
+            pending.channels[cid] = min(t, pending.channels.get(cid, math.inf))
+        pending.parameters.update(change.parameters)
+        pending.assets.update(change.assets)
 
     # ------------------------------------------------------------------ reads
     @property
@@ -145,7 +228,7 @@ class Document:
             self.channels.pop(cid, None)
         else:
             self.channels[cid] = channel
-        self.emit(ChangeEvent("channel", cid, time_from))
+        self.emit(DocumentChange(channels=MappingProxyType({cid: time_from})))
 
     def apply_parameter(self, path: str, value: Any) -> None:
         """Set (or with None remove) one parameter and announce it."""
@@ -153,7 +236,7 @@ class Document:
             self.parameters.pop(path, None)
         else:
             self.parameters[path] = value
-        self.emit(ChangeEvent("parameter", path))
+        self.emit(DocumentChange(parameters=frozenset((path,))))
 
     def apply_asset(self, asset_id: str, asset: Asset | None, runtime: Any = None,
                     index: int | None = None) -> None:
@@ -170,7 +253,7 @@ class Document:
                 self.assets[asset_id] = asset
             if runtime is not None:
                 self.runtime[asset_id] = runtime
-        self.emit(ChangeEvent("asset", asset_id))
+        self.emit(DocumentChange(assets=frozenset((asset_id,))))
 
     def set_view_state(self, key: str, value: Any) -> None:
         """Remember how an editor looks at the document (camera, zoom). Not an edit."""
@@ -184,7 +267,9 @@ class Document:
         self.runtime = other.runtime
         self.view_state = other.view_state
         self.path = other.path
-        self.emit(ChangeEvent("reset"))
+        if self._pending is not None:
+            self._pending = _PendingChange()  # a reset supersedes what the batch changed
+        self.emit(DocumentChange(reset=True))
 
     # -------------------------------------------------------------- snapshots
     def state(self) -> dict[str, Any]:

@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
 
 from qtanimator.core.cloth import INTEGRATORS, PIN_MODES, ClothParams, Sphere
 from qtanimator.document.cloth import ASSET_KIND, add_cloth_command, cloth_params, set_cloth_param_command
+from qtanimator.document.document import DocumentChange
 from qtanimator.ui.context import EditorContext
 
 _gestures = itertools.count(1)
@@ -293,8 +294,8 @@ class ClothPanel(QWidget):
         self.ctx.push(add_cloth_command(self.ctx.doc))
 
     # ------------------------------------------------------------ refresh
-    def _on_changed(self, event: Any) -> None:
-        if event.kind == "asset":
+    def _on_changed(self, change: DocumentChange) -> None:
+        if change.assets:
             self.refresh_assets()
 
     def refresh_assets(self) -> None:

@@ -1,17 +1,28 @@
 """The editing context every editor shares: document, undo stack, current frame, selection.
 
 Editors talk to each other only through this object: they read the document, push
-commands with :meth:`EditorContext.push`, and listen to the signals below.
+commands with :meth:`EditorContext.push` or drive a gesture from
+:meth:`EditorContext.begin_gesture`, and listen to the signals below.
+
+Change notification: the document announces one :class:`DocumentChange` per command.
+Outside gestures the context passes it on at once (``documentChanged``). While a gesture
+previews (a drag sends a command per mouse move), the context folds the changes and emits
+``documentChanged`` at most once per displayed frame (the frame clock below), so every
+view refreshes at most once per frame, from one change that names everything that moved.
 """
 
 from __future__ import annotations
 
-from PySide6.QtCore import QObject, Signal
+from PySide6.QtCore import QElapsedTimer, QObject, QTimer, Signal
 from PySide6.QtGui import QUndoStack
 
 from qtanimator.document.commands import Command
-from qtanimator.document.document import ChangeEvent, Document
-from qtanimator.ui.undo import push_command
+from qtanimator.document.document import Document, DocumentChange
+from qtanimator.document.gesture import Gesture
+from qtanimator.ui.undo import push_command, record_command
+
+#: The frame clock's period: views refresh at most once per 60 Hz frame during a gesture.
+FRAME_INTERVAL_MS = 16
 
 
 class EditorContext(QObject):
@@ -21,7 +32,7 @@ class EditorContext(QObject):
     selectionChanged = Signal(str, str)
     #: The selected channels changed (list of channel ids).
     channelSelectionChanged = Signal(list)
-    #: A document change (a ChangeEvent).
+    #: A document change (a DocumentChange: one per command, one per frame in a gesture).
     documentChanged = Signal(object)
     #: The whole document was replaced (New / Open / Recover).
     documentReset = Signal()
@@ -35,21 +46,71 @@ class EditorContext(QObject):
         self._frame = 0.0
         self._selection: tuple[str, str] = ("", "")
         self._channel_selection: list[str] = []
+        self._gestures: list[Gesture] = []
+        self._pending: DocumentChange | None = None
+        self._since_flush = QElapsedTimer()
+        self._since_flush.start()
+        self._frame_clock = QTimer(self)
+        self._frame_clock.setObjectName("documentFrameClock")
+        self._frame_clock.setSingleShot(True)
+        self._frame_clock.timeout.connect(self.flush_changes)
+        #: How many times ``documentChanged`` was emitted (tests count refreshes with it).
+        self.notifications = 0
         self.doc.subscribe(self._on_document_event)
 
     # ---------------------------------------------------------------- document
-    def _on_document_event(self, event: ChangeEvent) -> None:
-        if event.kind == "reset":
+    def _on_document_event(self, change: DocumentChange) -> None:
+        if change.reset:
+            self._pending = None
+            self._frame_clock.stop()
             self.documentReset.emit()
-        else:
-            self.documentChanged.emit(event)
+            return
+        self._pending = change if self._pending is None else self._pending.merged(change)
+        if not self._gestures:
+            self.flush_changes()
+        elif not self._frame_clock.isActive():
+            wait = max(0, FRAME_INTERVAL_MS - int(self._since_flush.elapsed()))
+            self._frame_clock.start(wait)
+
+    def flush_changes(self) -> None:
+        """Emit the folded pending change now (if any)."""
+        self._frame_clock.stop()
+        pending, self._pending = self._pending, None
+        if pending:
+            self._since_flush.restart()
+            self.notifications += 1
+            self.documentChanged.emit(pending)
 
     def push(self, command: Command) -> None:
         """Do a command and put it on the undo stack (merging drags into one step)."""
         push_command(self.undo_stack, self.doc, command)
 
+    # ---------------------------------------------------------------- gestures
+    def begin_gesture(self, text: str) -> Gesture:
+        """Start a gesture (see :mod:`qtanimator.document.gesture`): ``update(command)``
+        previews, ``commit()`` is one undo step, ``abort()`` puts everything back.
+        While any gesture is active, views refresh at most once per frame."""
+        gesture = Gesture(self.doc, text, self._record, on_end=self._gesture_ended)
+        self._gestures.append(gesture)
+        return gesture
+
+    @property
+    def gesture_active(self) -> bool:
+        return bool(self._gestures)
+
+    def _record(self, command: Command) -> None:
+        record_command(self.undo_stack, self.doc, command)
+
+    def _gesture_ended(self, gesture: Gesture) -> None:
+        if gesture in self._gestures:
+            self._gestures.remove(gesture)
+        if not self._gestures:
+            self.flush_changes()
+
     def replace_document(self, new: Document) -> None:
         """Take over ``new`` (already fully loaded) and clear the undo history."""
+        for gesture in list(self._gestures):
+            gesture.discard()
         self.undo_stack.clear()
         self._selection = ("", "")
         had_channels = bool(self._channel_selection)

@@ -31,6 +31,7 @@ from PySide6.QtWidgets import (
 from qtanimator.core.channel import Extrapolation, Tangent
 from qtanimator.document.commands import SetExtrapolation, SetTangents
 from qtanimator.document.curve_commands import SetKeysBroken
+from qtanimator.document.document import DocumentChange
 from qtanimator.ui.curves.fields import KeyFields
 from qtanimator.ui.curves.tree import ChannelTree
 from qtanimator.ui.curves.view import CurveView
@@ -231,11 +232,11 @@ class CurveEditor(QWidget):
                                        text=f"Extrapolation: {Extrapolation(mode).value}"))
 
     # -------------------------------------------------------------- syncing
-    def _document_changed(self, event: Any) -> None:
-        if event.kind == "channel":
-            present = event.key in self.ctx.doc.channels
-            if present != (event.key in self.tree.channel_ids()):
-                self.tree.set_channels(list(self.ctx.doc.channels))
+    def _document_changed(self, change: DocumentChange) -> None:
+        listed = set(self.tree.channel_ids())
+        channels = self.ctx.doc.channels
+        if any((cid in channels) != (cid in listed) for cid in change.channels):
+            self.tree.set_channels(list(channels))
 
     def _document_reset(self) -> None:
         self.view.reset()

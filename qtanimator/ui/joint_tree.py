@@ -3,22 +3,22 @@
 The tree follows ``ctx.selection`` and sets it; keyframed joints carry a key icon (filled
 once the joint has keys), dynamic (pendulum) joints a white bob. Below the tree, the DOF
 panel shows one slider and spin box per degree of freedom of the selected joint within
-its limits; an edit keys the DOF at the current frame, and one slider drag is one undo
-step (every command of the drag shares a gesture token).
+its limits; an edit keys the DOF at the current frame, and one slider drag is one gesture
+(``ctx.begin_gesture``): one undo step, and Escape during the drag puts the value back.
 """
 
 from __future__ import annotations
 
 import importlib
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from types import ModuleType
 from typing import TYPE_CHECKING
 
 import numpy as np
 from PySide6.QtCore import QPointF, Qt
-from PySide6.QtGui import QAction, QBrush, QColor, QIcon, QKeySequence, QPainter, QPen, QPixmap, QPolygonF
+from PySide6.QtGui import QAction, QBrush, QColor, QIcon, QKeyEvent, QKeySequence, QPainter, QPen, QPixmap, QPolygonF
 from PySide6.QtWidgets import (
     QDoubleSpinBox,
     QGridLayout,
@@ -33,7 +33,8 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator.document.commands import Command, Macro
-from qtanimator.document.document import ChangeEvent, Document, split_channel_id
+from qtanimator.document.document import Document, DocumentChange, split_channel_id
+from qtanimator.document.gesture import Gesture
 from qtanimator.ui.context import EditorContext
 
 if TYPE_CHECKING:
@@ -237,7 +238,8 @@ class DofRow:
         grid.addWidget(self.label, row, 0)
         grid.addWidget(self.slider, row, 1)
         grid.addWidget(self.spin, row, 2)
-        self._gesture: object | None = None
+        self._gesture: Gesture | None = None
+        self._aborted = False  # Escape ended the drag: ignore the slider until released
         self.set_value(spec.value)
         self.slider.sliderPressed.connect(self._begin)
         self.slider.sliderReleased.connect(self._end)
@@ -256,25 +258,43 @@ class DofRow:
         for w in (self.slider, self.spin):
             w.blockSignals(False)
 
+    @property
+    def dragging(self) -> bool:
+        return self._gesture is not None
+
     def _begin(self) -> None:
-        self._gesture = ("dof-slider", object())
+        """Slider pressed: one gesture until it is released (one undo step)."""
+        self._aborted = False
+        self._gesture = self.panel.ctx.begin_gesture(f"Set {self.spec.label}")
 
     def _end(self) -> None:
-        self._gesture = None
+        self._aborted = False
+        gesture, self._gesture = self._gesture, None
+        if gesture is not None:
+            gesture.commit()
+
+    def abort(self) -> None:
+        """Escape while dragging: put the value back as it was before the drag."""
+        gesture, self._gesture = self._gesture, None
+        if gesture is not None:
+            self._aborted = True
+            gesture.abort()
+            self.panel.rebuild()
 
     def _slider_changed(self, v: int) -> None:
+        if self._aborted:
+            return
         value = v / SLIDER_STEPS_PER_UNIT
-        gesture = self._gesture if self._gesture is not None else ("dof-step", object())
         self.spin.blockSignals(True)
         self.spin.setValue(value)
         self.spin.blockSignals(False)
-        self.panel.key(self.spec, value, gesture)
+        self.panel.key(self.spec, value, self._gesture)
 
     def _spin_changed(self, value: float) -> None:
         self.slider.blockSignals(True)
         self.slider.setValue(int(round(value * SLIDER_STEPS_PER_UNIT)))
         self.slider.blockSignals(False)
-        self.panel.key(self.spec, value, ("dof-spin", object()))
+        self.panel.key(self.spec, value, None)
 
 
 class DofPanel(QWidget):
@@ -328,15 +348,29 @@ class DofPanel(QWidget):
         else:
             self.title.setText(f"{asset} / {joint}" if joint else f"{asset} (position)")
 
-    def refresh_values(self) -> None:
-        if self._editing:
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        if event.key() == Qt.Key.Key_Escape and any(row.dragging for row in self.rows):
+            for row in self.rows:
+                row.abort()
+            event.accept()
             return
+        super().keyPressEvent(event)
+
+    def refresh_values(self) -> None:
+        if self._editing or any(row.dragging for row in self.rows):
+            return  # the row being edited already shows its value
         self.rebuild()
 
-    def key(self, spec: DofSpec, value: float, gesture: object) -> None:
+    def key(self, spec: DofSpec, value: float, gesture: Gesture | None) -> None:
+        """Key ``value``: a preview of the slider's gesture, or one undo step of its own
+        (arrow keys, page steps and typed values)."""
         self._editing = True
         try:
-            self.ctx.push(spec.make(value, self.ctx.time, gesture))
+            command = spec.make(value, self.ctx.time, None)
+            if gesture is not None:
+                gesture.update(command)
+            else:
+                self.ctx.push(command)
         finally:
             self._editing = False
 
@@ -385,14 +419,20 @@ class JointTree(QTreeWidget):
         self._syncing = False
         self.follow_selection()
 
-    def refresh_icons(self) -> None:
+    def refresh_icons(self, assets: Collection[str] | None = None) -> None:
+        """Update the keyed / not keyed icons of every joint (of ``assets`` only if given)."""
         doc = self.ctx.doc
+        shown = {k[0] for k in self._items}
+        targets = shown if assets is None else shown & set(assets)
+        if not targets:
+            return
         keyed: set[tuple[str, str]] = set()
-        for cid, ch in doc.channels.items():
-            if ch.keys:
-                a, j, _dof = split_channel_id(cid)
-                keyed.add((a, j))
-        for aid in {k[0] for k in self._items}:
+        for aid in targets:
+            for cid, ch in doc.channels_of(aid):
+                if ch.keys:
+                    a, j, _dof = split_channel_id(cid)
+                    keyed.add((a, j))
+        for aid in targets:
             for name, _parent, dynamic in joint_names(doc, aid):
                 item = self._items.get((aid, name))
                 if item is None:
@@ -459,14 +499,14 @@ class JointTreePanel(QWidget):
         self.tree.follow_selection()
         self.dofs.rebuild()
 
-    def _document_changed(self, event: ChangeEvent) -> None:
-        if event.kind == "asset":
+    def _document_changed(self, change: DocumentChange) -> None:
+        if change.assets:
             self.tree.rebuild()
             self.dofs.rebuild()
-        elif event.kind == "channel":
-            self.tree.refresh_icons()
-            self.dofs.refresh_values()
-        elif event.kind == "parameter":
+            return
+        if change.channels:
+            self.tree.refresh_icons(change.channel_assets())
+        if change.channels or change.parameters:
             self.dofs.refresh_values()
 
     def reset_pose(self) -> None:

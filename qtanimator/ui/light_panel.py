@@ -21,6 +21,7 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator.document.commands import SetParameter
+from qtanimator.document.document import DocumentChange
 from qtanimator.render.gl.lights import AMBIENT_PARAMETER, LIGHT_NAMES, parameter
 from qtanimator.ui.context import EditorContext
 
@@ -126,8 +127,8 @@ class LightPanel(QWidget):
         """Set a light (or the ambient) colour, as the colour picker does."""
         self._push(path, [round(color.redF(), 4), round(color.greenF(), 4), round(color.blueF(), 4)])
 
-    def _on_changed(self, event: Any) -> None:
-        if event.kind == "parameter" and (event.key.startswith("light") or event.key == AMBIENT_PARAMETER):
+    def _on_changed(self, change: DocumentChange) -> None:
+        if any(p.startswith("light") or p == AMBIENT_PARAMETER for p in change.parameters):
             self.refresh()
 
     def refresh(self) -> None:

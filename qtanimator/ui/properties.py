@@ -28,11 +28,11 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from qtanimator.document.character2d import IK_DEFAULTS, ik_setting
 from qtanimator.document.commands import SetParameter
-from qtanimator.document.document import ChangeEvent
+from qtanimator.document.document import DocumentChange
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.joint_tree import c2d, c3d
-from qtanimator.ui.rig_interaction import IK_DEFAULTS, ik_setting
 
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
@@ -83,11 +83,19 @@ class PropertiesPanel(QWidget):
         self.rebuild()
 
     # ------------------------------------------------------------ structure
-    def _on_document(self, event: ChangeEvent) -> None:
-        if event.kind == "asset":
+    def _on_document(self, change: DocumentChange) -> None:
+        if change.assets:
             self.rebuild()
-        else:
+        elif self._shows_changed(change):
             self.refresh()
+
+    def _shows_changed(self, change: DocumentChange) -> bool:
+        """True when the change touches what the dock shows: the selected asset's channels
+        or any parameter (IK, pendulum and project settings are shown for every selection)."""
+        if change.parameters:
+            return True
+        asset = self.ctx.selection[0]
+        return bool(asset) and asset in change.channel_assets()
 
     def refresh(self) -> None:
         for fn in self._refreshers:

@@ -6,7 +6,8 @@ Mouse (the reference animator's, plus a view you can move):
 * left-drag on a joint rotates it about its pivot, on the root moves the character;
 * right-drag pulls the picked point towards the cursor with IK (or, with *IK toggle mode*,
   the reference's toggle: right-press starts following the cursor, the next press stops);
-* every drag is one undo step; Escape takes the drag back;
+* every drag is one gesture (``ctx.begin_gesture``): each mouse move previews its command
+  at once, the release records one undo step, Escape takes the drag back exactly;
 * middle-drag pans, the wheel zooms about the cursor, F fits the scene in the view.
 
 Keys: Delete / Backspace delete the keys at the current frame; ``d`` toggles the debug
@@ -19,7 +20,6 @@ The gesture logic lives in :mod:`qtanimator.ui.rig_interaction` (no Qt).
 
 from __future__ import annotations
 
-import itertools
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -58,7 +58,8 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator.document.commands import Command
-from qtanimator.document.document import ChangeEvent
+from qtanimator.document.document import DocumentChange
+from qtanimator.document.gesture import Gesture
 from qtanimator.ui import rig_interaction as ri
 from qtanimator.ui.context import EditorContext
 
@@ -69,7 +70,6 @@ if TYPE_CHECKING:
 BACKGROUND = QColor(153, 153, 230)
 SCENE_LIMIT = 1.0e5
 ZOOM_PER_DEGREE = 1.0015  # per wheel unit (1/8 degree)
-_gesture_ids = itertools.count(1)
 
 
 def _c2d() -> Any:
@@ -218,7 +218,7 @@ class RigEditorView(QGraphicsView):
         self.sprites = JointSprites()
         # Interaction state.
         self._drag: Any = None
-        self._gesture: ri.Gesture | None = None
+        self._gesture: Gesture | None = None
         self._drag_button: Qt.MouseButton | None = None
         self._ik: tuple[str, int, np.ndarray] | None = None  # asset, joint, rest-pose source point
         self._ik_target: np.ndarray | None = None
@@ -282,8 +282,8 @@ class RigEditorView(QGraphicsView):
         self._poses = None
         self.viewport().update()
 
-    def _on_document(self, event: ChangeEvent) -> None:
-        if event.kind == "asset":
+    def _on_document(self, change: DocumentChange) -> None:
+        if change.assets:
             self.sprites.clear()
             self._sync_items()
             if self.ctx.selection[0] and self.ctx.selection[0] not in self.ctx.doc.assets:
@@ -296,7 +296,7 @@ class RigEditorView(QGraphicsView):
 
     def _on_reset(self) -> None:
         self.sprites.clear()
-        self.abort_drag()
+        self._reset_drag()  # the context discarded the gesture with the old document
         self.hover = None
         self._path_cache.clear()
         self._sync_items()
@@ -366,8 +366,8 @@ class RigEditorView(QGraphicsView):
         v.setValue(v.value() + int(round(delta.y())))
 
     # ------------------------------------------------------------------ mouse
-    def _new_gesture(self, text: str) -> ri.Gesture:
-        return ri.Gesture(self.ctx.doc, ("rig-editor", next(_gesture_ids)), text)
+    def _new_gesture(self, text: str) -> Gesture:
+        return self.ctx.begin_gesture(text)
 
     def mousePressEvent(self, event: QMouseEvent) -> None:
         button = event.button()
@@ -407,11 +407,11 @@ class RigEditorView(QGraphicsView):
             if joint == 0:
                 self.ctx.select(asset, "")
                 self._gesture = self._new_gesture(f"Move {asset}")
-                self._drag = ri.move_drag(self.ctx.doc, asset, point, time, self._gesture.token)
+                self._drag = ri.move_drag(self.ctx.doc, asset, point, time)
             else:
                 self.ctx.select(asset, character.joints[joint].name)
                 self._gesture = self._new_gesture(f"Rotate {character.joints[joint].name}")
-                self._drag = ri.rotate_drag(self.ctx.doc, asset, joint, point, time, self._gesture.token)
+                self._drag = ri.rotate_drag(self.ctx.doc, asset, joint, point, time)
             next(self._drag)
             self._drag_button = button
             event.accept()
@@ -424,7 +424,7 @@ class RigEditorView(QGraphicsView):
             character = self.ctx.doc.runtime[asset]
             self.ctx.select(asset, character.joints[joint].name if joint else "")
             self._gesture = self._new_gesture("IK Drag")
-            self._drag = ri.ik_drag(self.ctx.doc, asset, joint, point, time, self._gesture.token)
+            self._drag = ri.ik_drag(self.ctx.doc, asset, joint, point, time)
             next(self._drag)
             self._ik = (asset, joint, ri.ik_source(self.ctx.doc, asset, joint, point, time))
             self._ik_target = point
@@ -456,9 +456,8 @@ class RigEditorView(QGraphicsView):
             return
         if self._ik is not None:
             self._ik_target = np.asarray(point, dtype=np.float64)
-        command = self._drag.send(point)
-        self._gesture.apply(command)
-        self._invalidate()
+        self._gesture.update(self._drag.send(point))
+        self._invalidate()  # the preview is drawn now; other views follow once per frame
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
         if event.button() == Qt.MouseButton.MiddleButton and self._pan_from is not None:
@@ -476,13 +475,8 @@ class RigEditorView(QGraphicsView):
         """End the drag: its folded command goes on the undo stack as one step."""
         gesture = self._gesture
         self._reset_drag()
-        if gesture is None:
-            return
-        command = gesture.finish()
-        if command is not None and not command.is_noop():
-            self.ctx.push(command)
-        elif command is not None:
-            command.undo(self.ctx.doc)
+        if gesture is not None:
+            gesture.commit()
         self._invalidate()
 
     def abort_drag(self) -> None:
@@ -650,7 +644,7 @@ class RigEditorView(QGraphicsView):
         from qtanimator.core.ik import handout_gradient
 
         gradient = handout_gradient(character, pose, joint, local, self._ik_target)
-        scale = float(ri.ik_setting(doc, "ik.gradient_arrow_scale"))
+        scale = float(_c2d().ik_setting(doc, "ik.gradient_arrow_scale"))
         for start, end in ri.gradient_arrows(character, pose, gradient, scale):
             self._arrow(painter, start, end - start, QColor(255, 220, 0))
         self._dot(painter, pose.to_world(joint, local), 12.0, QColor(255, 0, 0))

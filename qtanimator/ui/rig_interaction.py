@@ -1,9 +1,10 @@
 """What the mouse does in the 2D rig editor, as plain functions and generators (no Qt).
 
 A drag is a generator (as in napari's mouse bindings): prime it with ``next(drag)``, then
-``drag.send(cursor)`` for each mouse move returns the command for that position. Every
-command of one drag carries the same gesture token, and :class:`Gesture` folds them into
-one command, so a drag is one undo step and Escape can take it back exactly.
+``drag.send(cursor)`` for each mouse move returns the command for that position, built
+from the document as it is now. The editor feeds each command to the gesture protocol
+(:class:`qtanimator.document.gesture.Gesture`: ``update`` previews it, ``commit`` makes the
+drag one undo step, ``abort`` — Escape — takes it back exactly).
 
 Points are world (scene) coordinates: SVG user units, y down.
 """
@@ -11,14 +12,15 @@ Points are world (scene) coordinates: SVG user units, y down.
 from __future__ import annotations
 
 import math
-from collections.abc import Generator, Hashable, Sequence
+from collections.abc import Generator, Sequence
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
-from qtanimator.document.commands import Command, Macro
+from qtanimator.document import character2d as c2d
+from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, channel_id
 
 FloatArray = npt.NDArray[np.float64]
@@ -28,23 +30,16 @@ Drag = Generator["Command | None", Any, None]
 PICK_TOLERANCE = 2.0
 
 
-def _c2d() -> Any:
-    from qtanimator.document import character2d
-
-    return character2d
-
-
 # ----------------------------------------------------------------------- scene
 def character_ids(doc: Document) -> list[str]:
     """The 2D characters of the document in draw order (later ones on top)."""
-    kind = _c2d().ASSET_KIND
+    kind = c2d.ASSET_KIND
     return [aid for aid, a in doc.assets.items() if a.kind == kind and aid in doc.runtime]
 
 
 def pick(doc: Document, time: float, point: Sequence[float],
          tolerance: float = PICK_TOLERANCE) -> tuple[str, int] | None:
     """The topmost (character, joint index) under ``point``, or None."""
-    c2d = _c2d()
     for aid in reversed(character_ids(doc)):
         character = doc.runtime[aid]
         pose = c2d.evaluate_pose(doc, aid, time)
@@ -64,134 +59,42 @@ def rotation_delta(pivot: Sequence[float], press: Sequence[float], cursor: Seque
     return math.atan2(ax * by - ay * bx, ax * bx + ay * by)
 
 
-# --------------------------------------------------------------------- gestures
-class Gesture:
-    """The commands of one drag folded into one: applied live, undone on abort."""
-
-    def __init__(self, doc: Document, token: Hashable, text: str = "Drag") -> None:
-        self.doc = doc
-        self.token = token
-        self.text = text
-        self.command: Command | None = None
-
-    @property
-    def active(self) -> bool:
-        return self.command is not None
-
-    def apply(self, command: Command | None) -> None:
-        """Do ``command`` on the document now and fold it into the gesture."""
-        if command is None:
-            return
-        command.do(self.doc)
-        if self.command is None:
-            self.command = command
-        elif not self.command.merge(command):
-            self.command = Macro(self.command.text, [self.command, command], gesture=self.token)
-
-    def abort(self) -> None:
-        """Undo everything the drag did (Escape)."""
-        if self.command is not None:
-            self.command.undo(self.doc)
-        self.command = None
-
-    def finish(self) -> Command | None:
-        """The one command to record (already done; doing it again is harmless)."""
-        command, self.command = self.command, None
-        return command
-
-
-def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float,
-                gesture: Hashable) -> Drag:
+# ------------------------------------------------------------------------ drags
+def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> Drag:
     """Left-drag on a joint: rotate it about its pivot following the cursor."""
-    c2d = _c2d()
     pose = c2d.evaluate_pose(doc, asset, time)
     pivot = pose.pivots[joint].copy()
     start = float(np.asarray(c2d.joint_angles(doc, asset, time))[joint])
     cursor = yield None
     while True:
         angle = start + rotation_delta(pivot, press, cursor)
-        cursor = yield c2d.key_joint(doc, asset, joint, angle, time, gesture=gesture)
+        cursor = yield c2d.key_joint(doc, asset, joint, angle, time)
 
 
-def move_drag(doc: Document, asset: str, press: Sequence[float], time: float, gesture: Hashable) -> Drag:
+def move_drag(doc: Document, asset: str, press: Sequence[float], time: float) -> Drag:
     """Left-drag on a root joint: move the character (a position key at ``time``)."""
-    c2d = _c2d()
     start = np.asarray(c2d.evaluate_pose(doc, asset, time).translation, dtype=np.float64).copy()
     p0 = np.asarray(press, dtype=np.float64)
     cursor = yield None
     while True:
         xy = start + (np.asarray(cursor, dtype=np.float64) - p0)
-        cursor = yield c2d.move_character(doc, asset, (float(xy[0]), float(xy[1])), time, gesture=gesture)
+        cursor = yield c2d.move_character(doc, asset, (float(xy[0]), float(xy[1])), time)
 
 
-#: IK solver settings (document parameters, edited in the properties dock).
-IK_DEFAULTS: dict[str, Any] = {
-    "ik.solver": "dls",             # "dls" (damped least squares) or "handout" (gradient descent)
-    "ik.freeze_root": True,
-    "ik.max_iterations": 100,
-    "ik.damping": 1e-3,
-    "ik.handout_step": 1e-6,
-    "ik.handout_iterations": 10,
-    "ik.gradient_arrow_scale": 0.1,
-}
-
-
-def ik_setting(doc: Document, name: str) -> Any:
-    return doc.parameter(name, IK_DEFAULTS[name])
-
-
-def ik_command(doc: Document, asset: str, joint: int, local_point: Sequence[float] | FloatArray,
-               target: Sequence[float] | FloatArray, time: float, gesture: Hashable) -> Command:
-    """One IK update as a keying command, with the solver settings of the document.
-
-    The default settings go through ``character2d.ik_drag``; other settings solve here
-    with ``core.ik`` and key the keyframed joints that moved (an adapter: ``ik_drag`` takes
-    only joint limits).
-    """
-    c2d = _c2d()
-    solver = str(ik_setting(doc, "ik.solver"))
-    custom = {k: doc.parameters[k] for k in IK_DEFAULTS if k in doc.parameters
-              and doc.parameters[k] != IK_DEFAULTS[k] and k != "ik.gradient_arrow_scale"}
-    if not custom:
-        return c2d.ik_drag(doc, asset, joint, local_point, target, time, gesture=gesture)
-    from qtanimator.core.ik import gradient_descent_step, solve_ik
-    from qtanimator.document.commands import SetKeys
-
-    character = doc.runtime[asset]
-    before = np.asarray(c2d.joint_angles(doc, asset, time), dtype=np.float64)
-    translation = c2d.translation(doc, asset, time)
-    if solver == "handout":
-        after = gradient_descent_step(character, before, translation, joint, local_point, target,
-                                      step=float(ik_setting(doc, "ik.handout_step")),
-                                      iterations=int(ik_setting(doc, "ik.handout_iterations")))
-    else:
-        after = solve_ik(character, before, translation, joint, local_point, target,
-                         freeze_root=bool(ik_setting(doc, "ik.freeze_root")),
-                         max_iterations=int(ik_setting(doc, "ik.max_iterations")),
-                         damping=float(ik_setting(doc, "ik.damping")))
-    from qtanimator.core.channel import Key
-
-    keys = {c2d.angle_channel_id(asset, j.name): Key(float(time), float(after[k]))
-            for k, j in enumerate(character.joints)
-            if not j.is_dynamic and abs(after[k] - before[k]) > 1e-12}
-    return SetKeys(doc, keys, text="IK drag", gesture=gesture)
-
-
-def ik_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float,
-            gesture: Hashable) -> Drag:
-    """Right-drag: pull the picked point of ``joint`` towards the cursor with the IK solver."""
-    c2d = _c2d()
+def ik_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> Drag:
+    """Right-drag: pull the picked point of ``joint`` towards the cursor with the IK solver
+    (the document's IK settings; see ``character2d.ik_drag``)."""
     pose = c2d.evaluate_pose(doc, asset, time)
     local = pose.to_local(joint, np.asarray(press, dtype=np.float64))
     cursor = yield None
     while True:
         target = np.asarray(cursor, dtype=np.float64)
-        cursor = yield ik_command(doc, asset, joint, local, target, time, gesture)
+        cursor = yield c2d.ik_drag(doc, asset, joint, local, target, time)
 
 
 def ik_source(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> FloatArray:
     """The rest-pose point of ``joint`` under ``press`` (kept for the debug dot)."""
-    pose = _c2d().evaluate_pose(doc, asset, time)
+    pose = c2d.evaluate_pose(doc, asset, time)
     return np.asarray(pose.to_local(joint, np.asarray(press, dtype=np.float64)), dtype=np.float64)
 
 
@@ -261,7 +164,6 @@ def path_keys(doc: Document, asset: str) -> list[PathKey]:
 def hud_lines(doc: Document, asset: str, joint: int | None, time: float) -> list[str]:
     """The HUD text: the character's position / velocity / acceleration and the joint's
     type with its angle (keyframed) or θ and ω (dynamic)."""
-    c2d = _c2d()
     character = doc.runtime[asset]
     cx, cy = _xy_channels(doc, asset)
     pos = (float(_eval(cx, time)), float(_eval(cy, time)))

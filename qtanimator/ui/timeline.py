@@ -24,7 +24,7 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator.document.commands import Macro, SetParameter
-from qtanimator.document.document import ChangeEvent, split_channel_id
+from qtanimator.document.document import DocumentChange, split_channel_id
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.playback import Playback, playback_frame
 
@@ -72,8 +72,8 @@ class TimelineWidget(QWidget):
         return QSize(800, 52)
 
     # --------------------------------------------------------------- keys
-    def _on_document_changed(self, event: ChangeEvent) -> None:
-        if event.kind in ("channel", "parameter", "asset"):
+    def _on_document_changed(self, change: DocumentChange) -> None:
+        if change:
             self._invalidate()
 
     def _invalidate(self) -> None:

@@ -11,16 +11,29 @@ _MERGE_ID = 0x51A  # any id other than -1 lets Qt ask mergeWith; Command.merge d
 
 
 class DocumentUndoCommand(QUndoCommand):
-    def __init__(self, doc: Document, command: Command) -> None:
+    """One Qt-free command on the QUndoStack. Each do and undo is one document batch, so
+    it announces one change however many channels it touches.
+
+    ``done``: the command is already done (a committed gesture): QUndoStack.push calls
+    ``redo`` once, which then does nothing; later redos do the command again.
+    """
+
+    def __init__(self, doc: Document, command: Command, done: bool = False) -> None:
         super().__init__(command.text)
         self.doc = doc
         self.command = command
+        self._skip_redo = done
 
     def redo(self) -> None:
-        self.command.do(self.doc)
+        if self._skip_redo:
+            self._skip_redo = False
+            return
+        with self.doc.batch():
+            self.command.do(self.doc)
 
     def undo(self) -> None:
-        self.command.undo(self.doc)
+        with self.doc.batch():
+            self.command.undo(self.doc)
 
     def id(self) -> int:
         return _MERGE_ID if self.command.gesture is not None else -1
@@ -42,9 +55,16 @@ def push_command(stack: QUndoStack, doc: Document, command: Command) -> None:
     A command that changes nothing is done but not recorded (Qt drops obsolete commands).
     """
     if command.is_noop() and not _continues_gesture(stack, command):
-        command.do(doc)
+        with doc.batch():
+            command.do(doc)
         return
     stack.push(DocumentUndoCommand(doc, command))
+
+
+def record_command(stack: QUndoStack, doc: Document, command: Command) -> None:
+    """Record a command that is already done (a committed gesture) as one undo step."""
+    if not command.is_noop():
+        stack.push(DocumentUndoCommand(doc, command, done=True))
 
 
 def _continues_gesture(stack: QUndoStack, command: Command) -> bool:
@@ -64,7 +84,8 @@ def drop_gesture(stack: QUndoStack, doc: Document, gesture: object) -> bool:
     top = stack.command(stack.index() - 1) if stack.index() > 0 else None
     if not isinstance(top, DocumentUndoCommand) or gesture is None or top.command.gesture != gesture:
         return False
-    top.command.undo(doc)
+    with doc.batch():
+        top.command.undo(doc)
     top.setObsolete(True)
     stack.undo()  # an obsolete command is removed without being undone again
     return True

@@ -37,6 +37,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from qtanimator.document.document import DocumentChange
 from qtanimator.render.gl import surface_format
 from qtanimator.render.gl.camera import OrbitCamera
 from qtanimator.render.gl.lights import LIGHT_NAMES, ambient_of, lights_of
@@ -198,8 +199,8 @@ class Viewport3D(QOpenGLWidget):
         self.restore_camera()
 
     # ------------------------------------------------------------ document
-    def _on_document_changed(self, event: Any) -> None:
-        if event.kind in ("asset", "parameter"):
+    def _on_document_changed(self, change: DocumentChange) -> None:
+        if change.assets or change.parameters:
             self.live.sync(self.ctx.doc)
         self.update()
 

@@ -8,8 +8,10 @@ without gestures, interleaving undo and redo. It also checks each change event's
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 
 import numpy as np
+import pytest
 from hypothesis import settings
 from hypothesis import strategies as st
 from hypothesis.stateful import RuleBasedStateMachine, invariant, precondition, rule
@@ -18,9 +20,9 @@ from qtanimator.core.channel import Channel, Extrapolation, Key, Tangent
 from qtanimator.document import (
     AddAsset,
     Asset,
-    ChangeEvent,
     DeleteKeys,
     Document,
+    DocumentChange,
     EditKey,
     InsertKey,
     Macro,
@@ -34,6 +36,7 @@ from qtanimator.document import (
     UndoStack,
 )
 from qtanimator.document.commands import Command
+from qtanimator.document.gesture import Gesture
 
 ASSETS = ["hero", "prop", "cam"]
 CIDS = ["hero//x", "hero/arm/rz", "hero/arm/ry", "prop//y", "cam//fov"]
@@ -58,25 +61,32 @@ class CommandMachine(RuleBasedStateMachine):
         self.stack = UndoStack(self.doc)
         self.states = [self.doc.state()]  # states[i]: after i recorded steps
         self.shadow: dict[str, Channel] = {}
+        self.notifications = 0
         self.doc.subscribe(self.on_event)
 
     # -------------------------------------------------------------- bookkeeping
-    def on_event(self, event: ChangeEvent) -> None:
-        assert event.kind in ("channel", "parameter", "asset")
-        if event.kind != "channel":
-            return
-        old = self.shadow.get(event.key)
-        new = self.doc.channels.get(event.key)
-        if old is not None and new is not None and event.time_from > -math.inf:
-            early = PROBE[PROBE < event.time_from]
-            assert np.array_equal(old.evaluate(early), new.evaluate(early)), event
-        if new is None:
-            self.shadow.pop(event.key, None)
-        else:
-            self.shadow[event.key] = new
+    def on_event(self, change: DocumentChange) -> None:
+        assert change and not change.reset
+        self.notifications += 1
+        for cid, time_from in change.channels.items():
+            old = self.shadow.get(cid)
+            new = self.doc.channels.get(cid)
+            if old is not None and new is not None and time_from > -math.inf:
+                early = PROBE[PROBE < time_from]
+                assert np.array_equal(old.evaluate(early), new.evaluate(early)), (cid, time_from)
+            if new is None:
+                self.shadow.pop(cid, None)
+            else:
+                self.shadow[cid] = new
+
+    def one_notification(self, action: Callable[[], object]) -> None:
+        """Run ``action``: however many channels it touches, at most one notification."""
+        before = self.notifications
+        action()
+        assert self.notifications - before <= 1
 
     def push(self, cmd: Command) -> None:
-        self.stack.push(cmd)
+        self.one_notification(lambda: self.stack.push(cmd))
         n = len(self.stack.done)
         self.states = self.states[:n] + [self.doc.state()]
         assert not self.stack.undone
@@ -185,15 +195,36 @@ class CommandMachine(RuleBasedStateMachine):
         first.undo(self.doc)
         self.push(Macro("Two keys", [first, second], gesture=gesture))
 
+    @precondition(lambda self: any(self.doc.channels.values()))
+    @rule(data=st.data(), commit=st.booleans())
+    def gesture(self, data: st.DataObject, commit: bool) -> None:
+        """A drag through the gesture protocol: previews, then one step or nothing."""
+        before = self.doc.state()
+        steps_before = len(self.stack.done)
+        gesture = Gesture(self.doc, "Drag", self.stack.record)
+        for key in data.draw(st.lists(keys(), min_size=1, max_size=4)):
+            cid = data.draw(st.sampled_from(CIDS))
+            self.one_notification(lambda c=cid, k=key: gesture.update(InsertKey(self.doc, c, k)))
+        if not commit:
+            gesture.abort()
+            assert self.doc.state() == before and len(self.stack.done) == steps_before
+            return
+        recorded = gesture.commit()
+        assert len(self.stack.done) == steps_before + (recorded is not None)
+        assert not self.stack.undone
+        if recorded is None:
+            assert self.doc.state() == before
+        self.states = self.states[:len(self.stack.done)] + [self.doc.state()]
+
     @rule()
     def undo(self) -> None:
         could = bool(self.stack.done)
-        assert self.stack.undo() == could
+        self.one_notification(lambda: self.stack.undo() == could or pytest.fail("undo"))
         assert self.doc.state() == self.states[len(self.stack.done)]
 
     @rule()
     def redo(self) -> None:
-        self.stack.redo()
+        self.one_notification(self.stack.redo)
         assert self.doc.state() == self.states[len(self.stack.done)]
 
     # ---------------------------------------------------------------- invariants

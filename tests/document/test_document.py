@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from qtanimator.core.channel import Channel, Key
-from qtanimator.document import Asset, ChangeEvent, Document
+from qtanimator.document import Asset, Document, DocumentChange
 from qtanimator.document.document import PROJECT_DEFAULTS
 
 
@@ -37,18 +37,19 @@ def test_channels_of_an_asset():
 
 def test_notification_and_reset():
     doc = Document()
-    seen: list[ChangeEvent] = []
+    seen: list[DocumentChange] = []
     doc.subscribe(seen.append)
     doc.apply_parameter("cloth.wind", 2.0)
     doc.apply_parameter("cloth.wind", None)
     doc.apply_asset("a", Asset("a", "light"), runtime="R")
     doc.apply_channel("a//x", Channel([Key(0, 1)]), time_from=0.5)
-    assert [e.kind for e in seen] == ["parameter", "parameter", "asset", "channel"]
+    assert [(set(e.parameters), set(e.assets), dict(e.channels)) for e in seen] == [
+        ({"cloth.wind"}, set(), {}), ({"cloth.wind"}, set(), {}), (set(), {"a"}, {}), (set(), set(), {"a//x": 0.5})]
     assert seen[-1].time_from == 0.5 and "cloth.wind" not in doc.parameters
     other = Document()
     other.parameters["fps"] = 30
     doc.replace_all(other)
-    assert seen[-1].kind == "reset" and doc.fps == 30 and doc.assets == {} and doc.runtime == {}
+    assert seen[-1].reset and doc.fps == 30 and doc.assets == {} and doc.runtime == {}
     doc.unsubscribe(seen.append)
     doc.apply_parameter("fps", 25)
     assert len(seen) == 5

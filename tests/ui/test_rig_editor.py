@@ -294,6 +294,7 @@ def test_rotation_delta_is_counter_clockwise_on_a_y_down_screen():
 def test_drag_generators_fold_into_one_exact_undo_step(shared_data):
     from qtanimator.document.commands import UndoStack
     from qtanimator.document.document import Document
+    from qtanimator.document.gesture import Gesture
     from qtanimator.ui import rig_interaction as ri
 
     doc = Document()
@@ -304,31 +305,36 @@ def test_drag_generators_fold_into_one_exact_undo_step(shared_data):
     pose = c2d.evaluate_pose(doc, asset, 0.0)
     pivot = pose.pivots[2]
     press = pivot + np.array([0.0, -50.0])
-    gesture = ri.Gesture(doc, ("test", 1))
-    drag_ = ri.rotate_drag(doc, asset, 2, press, 0.0, gesture.token)
+    gesture = Gesture(doc, "Rotate", stack.record)
+    drag_ = ri.rotate_drag(doc, asset, 2, press, 0.0)
     next(drag_)
     for deg in (5, 15, 30):
         a = math.radians(deg)
         cursor = pivot + np.array([[math.cos(a), math.sin(a)], [-math.sin(a), math.cos(a)]]) @ (press - pivot)
-        gesture.apply(drag_.send(cursor))
+        gesture.update(drag_.send(cursor))
     assert c2d.joint_angles(doc, asset, 0.0)[2] == pytest.approx(math.radians(30))
-    stack.push(gesture.finish())
+    assert gesture.commit() is not None
     assert len(stack.done) == 2  # the import and the whole drag
+    after = doc.state()
     stack.undo()
     assert doc.state() == before
+    stack.redo()
+    assert doc.state() == after
 
     # Abort leaves nothing behind.
-    gesture = ri.Gesture(doc, ("test", 2))
-    move = ri.move_drag(doc, asset, (0.0, 0.0), 0.0, gesture.token)
+    stack.undo()
+    gesture = Gesture(doc, "Move", stack.record)
+    move = ri.move_drag(doc, asset, (0.0, 0.0), 0.0)
     next(move)
-    gesture.apply(move.send((10.0, 4.0)))
+    gesture.update(move.send((10.0, 4.0)))
     np.testing.assert_allclose(c2d.translation(doc, asset, 0.0), (10.0, 4.0))
     gesture.abort()
-    assert doc.state() == before and gesture.finish() is None
+    assert doc.state() == before and gesture.commit() is None and len(stack.done) == 1
 
 
 def test_ik_generator_reaches_a_reachable_target(shared_data):
     from qtanimator.document.document import Document
+    from qtanimator.document.gesture import Gesture
     from qtanimator.ui import rig_interaction as ri
 
     doc = Document()
@@ -337,10 +343,10 @@ def test_ik_generator_reaches_a_reachable_target(shared_data):
     pose = c2d.evaluate_pose(doc, asset, 0.0)
     press = pose.to_world(2, doc.runtime[asset].joints[2].shapes[0].points.mean(axis=0))
     target = press + np.array([-40.0, 30.0])
-    gesture = ri.Gesture(doc, ("ik", 1))
-    ik = ri.ik_drag(doc, asset, 2, press, 0.0, gesture.token)
+    gesture = Gesture(doc, "IK", lambda _c: None)
+    ik = ri.ik_drag(doc, asset, 2, press, 0.0)
     next(ik)
-    gesture.apply(ik.send(target))
+    gesture.update(ik.send(target))
     local = pose.to_local(2, press)
     assert np.hypot(*(c2d.evaluate_pose(doc, asset, 0.0).to_world(2, local) - target)) < 1e-2
     # The handout's debug arrows start at each joint's first child, perpendicular to the bone.

@@ -33,7 +33,7 @@ from PySide6.QtWidgets import QGraphicsItem, QGraphicsRectItem, QWidget
 from qtanimator.core.channel import Channel, Key
 from qtanimator.document.commands import Command, DeleteKeys, InsertKey, MoveKeys
 from qtanimator.document.curve_commands import SetKeySlopes
-from qtanimator.document.document import ChangeEvent, split_channel_id
+from qtanimator.document.document import DocumentChange, split_channel_id
 from qtanimator.ui.curves.items import (
     HANDLE_SIZE,
     ChannelDrawing,
@@ -332,18 +332,19 @@ class CurveView(QObject):
             self.static_layer.update()
         self.live_layer.update()
 
-    def _document_changed(self, event: ChangeEvent) -> None:
-        if event.kind == "channel":
-            cid = event.key
+    def _document_changed(self, change: DocumentChange) -> None:
+        if "fps" in change.parameters:
+            self.refresh_all()
+        for cid in change.channels:
             if cid not in self.doc.channels:
                 self.cache.drop(cid)
             if self._drag is None:
                 self._map_selection(cid)
+        if change.channels:
             self._prune_selection()
+        for cid in change.channels:
             if cid in self.visible:
                 self.refresh_channel(cid)
-        elif event.kind == "parameter" and event.key == "fps":
-            self.refresh_all()
 
     def _map_selection(self, cid: str) -> None:
         """Channel ``cid`` changed (an undo, another editor): keep its selected keys selected.
