@@ -45,6 +45,7 @@ from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.atomic import write_atomic
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.glb import build_glb, is_glb, parse_json_text, read_glb
+from qtanimator.formats.limits import MAX_JOINTS, MAX_NODES, decoded_budget, exceeded
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -427,11 +428,22 @@ class GltfScene:
 class _Reader:
     """Validating access to the JSON with errors that name where the problem is."""
 
-    def __init__(self, doc: dict[str, Any], buffers: list[bytes], path: str | None) -> None:
+    def __init__(self, doc: dict[str, Any], buffers: list[bytes], path: str | None,
+                 input_bytes: int = 0) -> None:
         self.doc = doc
         self.buffers = buffers
         self.path = path
         self._accessors: dict[int, Any] = {}
+        #: Bytes of decoded accessor data allowed (proportional to the input, capped).
+        self.budget = decoded_budget(input_bytes + sum(len(b) for b in buffers))
+        self.decoded = 0
+
+    def spend(self, nbytes: int, where: str) -> None:
+        """Count ``nbytes`` of decoded data against the budget before allocating them."""
+        self.decoded += nbytes
+        if self.decoded > self.budget:
+            raise exceeded(f"{where}: the decoded data ({self.decoded} bytes so far)",
+                           f"{self.budget} bytes for a file of this size", self.path)
 
     def error(self, message: str) -> FormatError:
         return FormatError(message, self.path)
@@ -546,6 +558,9 @@ class _Reader:
         col_stride = col_bytes + ((-col_bytes) % 4 if cols > 1 else 0)
         elem = col_stride * cols
         view_index = self.integer(acc, "bufferView", aw)
+        # What this accessor will hold, decoded (8-byte numbers), counted before allocation:
+        # many accessors sharing one small view must not expand without bound.
+        self.spend(count * ncomp * 8 * (2 if acc.get("sparse") is not None else 1), aw)
         if view_index is None:
             if count * ncomp > MAX_ZERO_ELEMENTS:
                 raise self.error(f"{aw} has no buffer view and {count} elements; that is too many.")
@@ -654,11 +669,26 @@ def _read_uri(uri: str, base: Path | None, where: str, path: str | None) -> byte
     parsed = urllib.parse.urlparse(uri)
     if parsed.scheme and len(parsed.scheme) > 1:
         raise FormatError(f"{where}.uri {_short(uri)} is not a local file.", path)
-    target = base / urllib.parse.unquote(uri)
+    target = contained_path(base, uri, where, path)
     try:
         return read_bytes(target)
     except (OSError, ValueError) as exc:  # FormatError too: a folder, a device, a missing file
         raise FormatError(f"{where} refers to {_short(uri)}, which cannot be read.", path) from exc
+
+
+def contained_path(base: Path, uri: str, where: str, path: str | None) -> Path:
+    """The file a relative ``uri`` names inside ``base`` (the glTF's folder), after
+    percent-escapes, ``..`` and symbolic links are resolved; FormatError when it lies
+    outside that folder (an absolute path, ``../``, a link pointing out)."""
+    try:
+        folder = base.resolve(strict=False)
+        target = (folder / urllib.parse.unquote(uri)).resolve(strict=False)
+    except (OSError, ValueError, RuntimeError) as exc:  # a NUL byte, a symlink loop
+        raise FormatError(f"{where}.uri {_short(uri)} is not a usable file name.", path) from exc
+    if not target.is_relative_to(folder):
+        raise FormatError(f"{where}.uri {_short(uri)} points outside the glTF's folder; qtanimator "
+                          "reads only files beside the glTF or in folders below it.", path)
+    return target
 
 
 def import_gltf(path: str | os.PathLike[str]) -> GltfScene:
@@ -678,7 +708,7 @@ def parse_gltf(data: bytes, path: str | os.PathLike[str] | None = None, base: Pa
     else:
         doc, bin_chunk = parse_json_text(data, spath), None
     try:
-        return _build_scene(doc, bin_chunk, base, spath)
+        return _build_scene(doc, bin_chunk, base, spath, len(data))
     except FormatError:
         raise
     except (ValueError, TypeError, KeyError, IndexError, OverflowError, MemoryError, RecursionError) as exc:
@@ -687,7 +717,8 @@ def parse_gltf(data: bytes, path: str | os.PathLike[str] | None = None, base: Pa
                           spath) from exc
 
 
-def _build_scene(doc: dict[str, Any], bin_chunk: bytes | None, base: Path | None, path: str | None) -> GltfScene:
+def _build_scene(doc: dict[str, Any], bin_chunk: bytes | None, base: Path | None, path: str | None,
+                 input_bytes: int = 0) -> GltfScene:
     asset = doc.get("asset")
     if not isinstance(asset, dict) or not isinstance(asset.get("version"), str):
         raise FormatError("the glTF has no asset.version; is this a glTF 2.0 file?", path)
@@ -700,7 +731,7 @@ def _build_scene(doc: dict[str, Any], bin_chunk: bytes | None, base: Path | None
         raise FormatError(f"the file requires extensions qtanimator does not support: "
                           f"{', '.join(_short(x) for x in required)}.", path)
     buffers = _load_buffers(doc, bin_chunk, base, path)
-    r = _Reader(doc, buffers, path)
+    r = _Reader(doc, buffers, path, input_bytes)
     scene = GltfScene(path=path, generator=str(asset.get("generator", "")))
     scene.nodes = _read_nodes(r)
     scene.skins = _read_skins(r, len(scene.nodes))
@@ -730,6 +761,8 @@ def _build_scene(doc: dict[str, Any], bin_chunk: bytes | None, base: Path | None
 
 def _read_nodes(r: _Reader) -> list[GltfNode]:
     raw = r.collection("nodes")
+    if len(raw) > MAX_NODES:
+        raise exceeded(f"the scene's {len(raw)} nodes", f"{MAX_NODES} nodes", r.path)
     nodes: list[GltfNode] = []
     for i, nd in enumerate(raw):
         w = f"nodes[{i}]"
@@ -799,6 +832,8 @@ def _read_skins(r: _Reader, num_nodes: int) -> list[GltfSkin]:
         joints_raw = r.array(sk, "joints", w)
         if not joints_raw:
             raise r.error(f"{w} has no joints.")
+        if len(joints_raw) > MAX_JOINTS:
+            raise exceeded(f"{w} with {len(joints_raw)} joints", f"{MAX_JOINTS} joints per skin", r.path)
         joints = []
         for k, j in enumerate(joints_raw):
             joints.append(r.item(j, f"{w}.joints[{k}]", num_nodes))

@@ -98,5 +98,10 @@ def test_a_gltf_buffer_that_points_at_a_device_is_refused(tmp_path: Path) -> Non
         pytest.skip("no /dev/zero here")
     gltf = tmp_path / "scene.gltf"
     gltf.write_text('{"asset": {"version": "2.0"}, "buffers": [{"uri": "/dev/zero", "byteLength": 4}]}')
+    with pytest.raises(FormatError, match="outside the glTF's folder"):
+        import_gltf(gltf)
+    # A pipe inside the folder is refused as a pipe (reading it would never end).
+    os.mkfifo(tmp_path / "pipe.bin")
+    gltf.write_text('{"asset": {"version": "2.0"}, "buffers": [{"uri": "pipe.bin", "byteLength": 4}]}')
     with pytest.raises(FormatError, match="cannot be read"):
         import_gltf(gltf)
