@@ -45,7 +45,7 @@ from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.atomic import write_atomic
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.glb import build_glb, is_glb, parse_json_text, read_glb
-from qtanimator.formats.limits import MAX_JOINTS, MAX_NODES, decoded_budget, exceeded
+from qtanimator.formats.limits import MAX_JOINTS, MAX_NODES, MAX_VERTICES, decoded_budget, exceeded
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -437,6 +437,7 @@ class _Reader:
         #: Bytes of decoded accessor data allowed (proportional to the input, capped).
         self.budget = decoded_budget(input_bytes + sum(len(b) for b in buffers))
         self.decoded = 0
+        self.vertices = 0
 
     def spend(self, nbytes: int, where: str) -> None:
         """Count ``nbytes`` of decoded data against the budget before allocating them."""
@@ -863,6 +864,9 @@ def _read_mesh(r: _Reader, mi: int, mesh: dict[str, Any]) -> GltfMesh:
         attrs = r.obj(prim.get("attributes"), f"{pw}.attributes")
         pos_index = r.integer(attrs, "POSITION", f"{pw}.attributes", required=True)
         positions = _float_attr(r, pos_index or 0, f"{pw}.attributes.POSITION", 3)
+        r.vertices += len(positions)
+        if r.vertices > MAX_VERTICES:
+            raise exceeded(f"the meshes' {r.vertices} vertices", f"{MAX_VERTICES} vertices per file", r.path)
         nv = len(positions)
 
         normals = _optional_attr(r, attrs, pw, "NORMAL", 3, nv)

@@ -3,7 +3,6 @@ would expand into gigabytes. Each must be refused with a FormatError naming the 
 
 from __future__ import annotations
 
-import base64
 import json
 import os
 import struct
@@ -170,3 +169,19 @@ def test_a_skin_within_the_joint_limit_still_opens(tmp_path: Path) -> None:
            "skins": [{"joints": list(range(n))}]}
     path.write_text(json.dumps(doc))
     assert len(import_gltf(path).skins[0].joints) == n
+
+
+def test_too_many_vertices_are_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    from qtanimator.formats import gltf
+
+    monkeypatch.setattr(gltf, "MAX_VERTICES", 2)  # the limit is counted over every primitive
+    path = gltf_with_buffer(tmp_path, "tri.bin", 12)
+    (tmp_path / "tri.bin").write_bytes(struct.pack("<3f", 1.0, 2.0, 3.0))
+    doc = json.loads(path.read_text())
+    doc["meshes"][0]["primitives"] *= 3
+    path.write_text(json.dumps(doc))
+    with pytest.raises(FormatError, match="limit of 2 vertices"):
+        import_gltf(path)
+    doc["meshes"][0]["primitives"] = doc["meshes"][0]["primitives"][:2]
+    path.write_text(json.dumps(doc))
+    assert len(import_gltf(path).meshes[0].primitives) == 2
