@@ -12,9 +12,13 @@ os.umask(_UMASK)
 
 
 def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
-    """Write ``data`` to a temporary file beside ``path``, flush it, then ``os.replace``."""
+    """Write ``data`` to a temporary file beside ``path``, flush it, then ``os.replace``.
+
+    The temporary file's name carries this process's id, so a save killed half-way
+    (``kill -9``, a power cut) leaves a file the next save recognises and removes."""
     target = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent or ".")
+    remove_stale_temporaries(target)
+    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.{os.getpid()}.", suffix=".tmp", dir=target.parent or ".")
     try:
         # mkstemp makes the file private (0600); a save must not change who may read it.
         os.chmod(tmp, mode_for(target))
@@ -29,6 +33,40 @@ def write_atomic(path: str | os.PathLike[str], data: bytes) -> None:
         except OSError:
             pass
         raise
+
+
+def remove_stale_temporaries(target: Path) -> list[Path]:
+    """Delete the temporary files of saves of ``target`` whose process no longer runs;
+    returns what was removed. Temporaries of running processes are left alone."""
+    removed = []
+    prefix = f".{target.name}."
+    try:
+        candidates = [p for p in (target.parent or Path(".")).iterdir()
+                      if p.name.startswith(prefix) and p.name.endswith(".tmp")]
+    except OSError:
+        return removed
+    for p in candidates:
+        pid_text = p.name[len(prefix):].split(".", 1)[0]
+        if not pid_text.isdigit() or _running(int(pid_text)):
+            continue
+        try:
+            p.unlink()
+            removed.append(p)
+        except OSError:
+            pass
+    return removed
+
+
+def _running(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except OSError:  # it exists but belongs to someone else
+        return True
+    return True
 
 
 def mode_for(path: str | os.PathLike[str]) -> int:
