@@ -96,6 +96,46 @@ PRESETS: dict[str, PendulumParams] = {
 }
 
 
+#: Angular speeds above this (rad/s, about 160 turns per second) count as a blow-up even
+#: while the numbers are still finite: no pendulum an animator keys swings that fast.
+RUNAWAY_RATE = 1.0e3
+
+
+class PendulumBlowUp(RuntimeError):
+    """A pendulum simulation went unstable at ``time`` (s); ``parameter`` names the setting
+    to change first, ``joint`` the joint that ran away."""
+
+    def __init__(self, message: str, parameter: str, time: float, joint: str) -> None:
+        super().__init__(message)
+        self.message = message
+        self.parameter = parameter
+        self.time = time
+        self.joint = joint
+
+
+def check_state(character: Character, params: PendulumParams, theta: FloatArray, omega: FloatArray,
+                time: float) -> PendulumBlowUp | None:
+    """The blow-up the state ``(theta, omega)`` at ``time`` shows, or None if it is sound:
+    a non-finite angle or rate, or a rate beyond :data:`RUNAWAY_RATE`. The message says
+    what to change: a negative damping pumps energy in; otherwise the fixed step is too
+    large for the forces and the integrator is unstable."""
+    bad = ~(np.isfinite(theta) & np.isfinite(omega)) | (np.abs(np.nan_to_num(omega, nan=np.inf)) > RUNAWAY_RATE)
+    if not bad.any():
+        return None
+    k = int(np.flatnonzero(bad)[0])
+    name = character.joints[k].name
+    if params.damping < 0:
+        parameter, advice = "damping", "the damping is negative, which adds energy every step; make it 0 or more"
+    else:
+        parameter, advice = "step", (f"the step of {params.step:g} s is too large for gravity "
+                                     f"{params.g:g} and these accelerations; use a smaller step, more damping "
+                                     "or a weaker gravity")
+    what = "not a finite number" if not (np.isfinite(theta[k]) and np.isfinite(omega[k])) else \
+        f"spinning at {abs(float(omega[k])):.3g} rad/s"
+    return PendulumBlowUp(f"the pendulum '{name}' blew up at {time:.3f} s ({what}): {advice}.",
+                          parameter, time, name)
+
+
 def rotate(v: FloatArray, theta: FloatArray | float) -> FloatArray:
     """R(θ)·v, vectorised over leading axes (θ broadcast against v[..., 0])."""
     c, s = np.cos(theta), np.sin(theta)

@@ -197,3 +197,21 @@ def test_pivot_acceleration_from_a_rotating_parent() -> None:
     acc = pivot_accelerations(ch2, np.array([0.0, 0.3, 0.3]), np.array([0.0, w, w]), np.zeros(3), (1.0, 2.0))
     r = 100.0 * np.array([math.sin(0.3), math.cos(0.3)])
     np.testing.assert_allclose(acc[2], np.array([1.0, 2.0]) - w * w * r, atol=1e-9)
+
+
+def test_a_blow_up_is_detected_and_names_what_to_change():
+    from qtanimator.core.pendulum import RUNAWAY_RATE, PendulumParams, check_state
+    from qtanimator.core.rig2d import Character, Joint
+
+    ch = Character("c", [Joint("root", None, np.zeros(2), children=[1]),
+                         Joint("bob", 0, np.array([0.0, 10.0]), is_dynamic=True)])
+    params = PendulumParams()
+    theta, omega = np.zeros(2), np.zeros(2)
+    assert check_state(ch, params, theta, omega, 0.5) is None
+    omega[1] = RUNAWAY_RATE * 1.01
+    report = check_state(ch, params, theta, omega, 0.5)
+    assert report is not None and report.joint == "bob" and report.parameter == "step" and "0.500 s" in report.message
+    omega[1] = 0.0
+    theta[1] = np.nan
+    report = check_state(ch, PendulumParams(damping=-5.0), theta, omega, 1.0)
+    assert report is not None and report.parameter == "damping" and "not a finite number" in report.message
