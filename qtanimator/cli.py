@@ -100,6 +100,9 @@ def _gui(args: list[str]) -> int:
 
     from qtanimator.ui.main_window import MainWindow
 
+    # Simulation and autosave workers share the GIL with the UI thread: hand it over every
+    # millisecond (Python's default is 5 ms) so the UI's turn comes well inside a frame.
+    sys.setswitchinterval(0.001)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("qtanimator")
     app.setOrganizationName("qtanimator")

@@ -17,11 +17,12 @@ polynomial coefficients, no Python loop per sample.
 
 from __future__ import annotations
 
+import itertools
 import math
 from bisect import bisect_right
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
-from enum import StrEnum
+from enum import Enum, StrEnum
 from typing import Any, overload
 
 import numpy as np
@@ -449,14 +450,101 @@ class Channel:
         return comp
 
     # ------------------------------------------------------------- persistence
-    def to_dict(self) -> dict[str, Any]:
-        return {"pre": self.pre.value, "post": self.post.value,
-                "keys": [k.to_dict() for k in self.keys]}
+    def to_dict(self, columns: bool = False) -> dict[str, Any]:
+        """Plain JSON data: ``pre``, ``post`` and the keys.
+
+        By default the keys are a list of objects ``{"t", "v", "in", "out"[, "interp"]
+        [, "broken"]}`` (project format 1; :meth:`Document.state` compares this form).
+        With ``columns`` they are columns (project format 2): ``times`` and ``values``
+        arrays, and ``in`` / ``out`` / ``interp`` / ``broken`` each written once when every
+        key shares it (an ``in`` rule name or fixed slope) and as one entry per key
+        otherwise; ``interp`` is left out when every span is cubic and ``broken`` when no
+        key is broken, as in the key form.
+        """
+        d: dict[str, Any] = {"pre": self.pre.value, "post": self.post.value}
+        if not columns:
+            d["keys"] = [k.to_dict() for k in self.keys]
+            return d
+        keys = self.keys
+        if keys:
+            d["in"] = _rule_column([k.in_tangent for k in keys], [k.in_slope for k in keys])
+            d["out"] = _rule_column([k.out_tangent for k in keys], [k.out_slope for k in keys])
+            interp = _shared([k.interpolation for k in keys])
+            if interp is not Interpolation.CUBIC:
+                d["interp"] = interp._value_ if isinstance(interp, Interpolation) else [m._value_ for m in interp]
+            broken = _shared([k.broken for k in keys])
+            if broken is not False:
+                d["broken"] = broken
+        # Plain floats (a key made in code may hold an int): what loads back saves the same.
+        d["times"] = [float(k.time) for k in keys]
+        d["values"] = [float(k.value) for k in keys]
+        return d
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Channel:
-        return cls([Key.from_dict(k) for k in d.get("keys", [])],
-                   d.get("pre", "constant"), d.get("post", "constant"))
+        """Read either form written by :meth:`to_dict` (ValueError / TypeError / KeyError if
+        it is malformed)."""
+        pre, post = d.get("pre", "constant"), d.get("post", "constant")
+        if "times" not in d and "values" not in d:
+            return cls([Key.from_dict(k) for k in d.get("keys", [])], pre, post)
+        if "keys" in d:
+            raise ValueError("a channel has either \"keys\" or \"times\" and \"values\", not both")
+        times, values = d["times"], d["values"]
+        if not isinstance(times, list) or not isinstance(values, list):
+            raise TypeError("\"times\" and \"values\" must be lists")
+        n = len(times)
+        if len(values) != n:
+            raise ValueError(f"{n} times but {len(values)} values")
+        columns = {name: d.get(name, default) for name, default in
+                   (("in", "smooth"), ("out", "smooth"), ("interp", "cubic"), ("broken", False))}
+        for name, column in columns.items():
+            if isinstance(column, list) and len(column) != n:
+                raise ValueError(f"\"{name}\" has {len(column)} entries for {n} keys")
+        ins, outs, interps, brokens = columns.values()
+        if not all(isinstance(b, bool) for b in (brokens if isinstance(brokens, list) else [brokens])):
+            raise TypeError("\"broken\" must be true or false")
+        if not isinstance(brokens, list):
+            brokens = itertools.repeat(brokens, n)
+        if not any(isinstance(c, list) for c in (ins, outs, interps)):
+            # Every key shares its rules: resolve them once (a long channel loads faster).
+            in_rule, in_slope = _rule_and_slope(ins)
+            out_rule, out_slope = _rule_and_slope(outs)
+            interp = Interpolation(interps)
+            return cls([Key(float(t), float(v), in_rule, out_rule, in_slope, out_slope, interp, b)
+                        for t, v, b in zip(times, values, brokens)], pre, post)
+        ins, outs, interps = (c if isinstance(c, list) else itertools.repeat(c, n) for c in (ins, outs, interps))
+        return cls([Key.make(t, v, i, o, interpolation=Interpolation(m), broken=b)
+                    for t, v, i, o, m, b in zip(times, values, ins, outs, interps, brokens)], pre, post)
+
+
+_FIXED = Tangent.FIXED
+
+
+def _shared(items: list[Any]) -> Any:
+    """The one value every item has, or ``items`` itself when they differ. Items of one
+    value must also have one type and one ``repr`` (``1`` is not ``1.0``, ``-0.0`` is not
+    ``0.0``), so a shared value writes every item exactly."""
+    first = items[0]
+    # list.count compares by identity first: one rule (an enum member) or one bool is fast.
+    if items.count(first) != len(items):
+        return items
+    if isinstance(first, (Enum, bool)) or all(item is first for item in items):
+        return first
+    if len({type(item) for item in items}) != 1 or len({repr(item) for item in items}) != 1:
+        return items
+    return first
+
+
+def _rule_column(rules: list[Tangent], slopes: list[float]) -> Any:
+    """One side's tangents in the column form: a rule name or a fixed slope, shared by
+    every key or one per key. ``_value_`` is a member's plain string (``.value`` is a slow
+    property)."""
+    rule = _shared(rules)
+    if rule is _FIXED:
+        return _shared([float(s) for s in slopes])
+    if isinstance(rule, Tangent):
+        return rule._value_
+    return [float(s) if r is _FIXED else r._value_ for r, s in zip(rules, slopes)]
 
 
 def _poly(coef: tuple[float, float, float, float], x: float, deriv: int) -> float:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import copy
 import os
 from pathlib import Path
 
@@ -12,10 +13,18 @@ from qtanimator.formats.project import AssetRecord, ProjectData, load_project, s
 
 
 def to_project_data(doc: Document) -> ProjectData:
+    """A snapshot of what a project file stores, cheap enough for the UI thread.
+
+    Channels are immutable values, so a copy of the channel dict is enough (no key is
+    copied). Parameters, view state and asset properties are small and copied in depth, so
+    the snapshot stays as it was while a worker thread writes it, whatever the document
+    does meanwhile (commands replace assets rather than change them, but a copy costs
+    nothing and keeps that a convention, not a requirement).
+    """
     return ProjectData(
-        parameters=dict(doc.parameters),
-        view=dict(doc.view_state),
-        assets=[AssetRecord(a.id, a.kind, a.source, a.properties) for a in doc.assets.values()],
+        parameters=copy.deepcopy(doc.parameters),
+        view=copy.deepcopy(doc.view_state),
+        assets=[AssetRecord(a.id, a.kind, a.source, copy.deepcopy(a.properties)) for a in doc.assets.values()],
         channels=dict(doc.channels),
     )
 

@@ -4,14 +4,28 @@
 
     {
       "format": "qtanimator-project",
-      "version": 1,
+      "version": 2,
       "parameters": {"fps": 60.0, "frame_start": 0, "frame_end": 240, ...},
       "assets": [{"id": "clock", "kind": "character2d", "source": "clock.svg",
                   "properties": {...}}, ...],
-      "channels": {"clock/pendulum/angle": {"pre": "constant", "post": "constant",
-                                            "keys": [{"t": 0.0, "v": 0.5, "in": "smooth",
-                                                      "out": "smooth"}]}}
+      "channels": {
+        "clock/pendulum/angle": {
+          "pre": "constant",
+          "post": "constant",
+          "in": "smooth",
+          "out": "smooth",
+          "times": [0.0, 0.5, 1.0],
+          "values": [0.5, -0.5, 0.5]
+        }
+      }
     }
+
+A channel's keys are columns (version 2): ``times`` and ``values``, and the tangent rules
+``in`` / ``out`` (a rule name or a fixed slope), the span shape ``interp`` (left out when
+cubic) and ``broken`` (left out when false), each written once when every key shares it
+and as one entry per key otherwise. Number columns are written :data:`NUMBERS_PER_LINE` to
+a line. Version 1 wrote one object per key, ``"keys": [{"t": 0.0, "v": 0.5, "in":
+"smooth", "out": "smooth"}, ...]``; that form is still read.
 
 Asset ``source`` paths and asset properties whose name ends in ``_file`` are stored
 relative to the project file and made absolute on load. This module knows the schema only;
@@ -23,17 +37,21 @@ from __future__ import annotations
 import json
 import math
 import os
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from qtanimator.core.channel import Channel
 from qtanimator.formats._tokens import read_bytes
-from qtanimator.formats.atomic import write_text_atomic
+from qtanimator.formats.atomic import write_chunks_atomic
 from qtanimator.formats.errors import FormatError
 
 FORMAT_NAME = "qtanimator-project"
-FORMAT_VERSION = 1
+FORMAT_VERSION = 2
+
+#: How many numbers a line of a ``times`` / ``values`` column holds.
+NUMBERS_PER_LINE = 10
 
 
 @dataclass
@@ -55,6 +73,14 @@ class ProjectData:
 
 def project_to_json(data: ProjectData, base_dir: str | os.PathLike[str]) -> str:
     """Serialise deterministically: save, load, save gives identical bytes."""
+    return "".join(project_json_parts(data, base_dir))
+
+
+def project_json_parts(data: ProjectData, base_dir: str | os.PathLike[str]) -> Iterator[str]:
+    """:func:`project_to_json` in pieces of at most a few hundred kB, so that a writer can
+    stream them to disk and stop between them, and no single step of a background save
+    holds the GIL for long. Raises ValueError for a value JSON cannot store.
+    """
     base = Path(base_dir).resolve()
     assets = []
     for a in data.assets:
@@ -63,18 +89,91 @@ def project_to_json(data: ProjectData, base_dir: str | os.PathLike[str]) -> str:
             source = _relative(Path(source), base)
         props = {k: (_relative(Path(v), base) if _is_path_key(k, v) else v) for k, v in a.properties.items()}
         assets.append({"id": a.id, "kind": a.kind, "source": source, "properties": props})
-    doc = {
-        "format": FORMAT_NAME,
-        "version": FORMAT_VERSION,
-        "parameters": data.parameters,
-        "assets": assets,
-        "channels": {cid: ch.to_dict() for cid, ch in data.channels.items()},
-    }
+    yield "{\n"
+    yield f'  "format": {_json(FORMAT_NAME, 1)},\n'
+    yield f'  "version": {_json(FORMAT_VERSION, 1)},\n'
+    yield f'  "parameters": {_json(data.parameters, 1)},\n'
+    yield f'  "assets": {_json(assets, 1)},\n'
+    if not data.channels:
+        yield '  "channels": {}'
+    else:
+        yield '  "channels": {'
+        sep = "\n"
+        for cid, ch in data.channels.items():
+            yield f"{sep}    {_INLINE.encode(cid)}: {{\n"
+            yield from _channel_parts(ch)
+            yield "\n    }"
+            sep = ",\n"
+        yield "\n  }"
     if data.view:
-        doc["view"] = data.view
+        yield f',\n  "view": {_json(data.view, 1)}'
+    yield "\n}\n"
+
+
+def _json(value: Any, level: int) -> str:
+    """``json.dumps(value, indent=2)`` as it reads nested ``level`` objects deep."""
     try:
-        return json.dumps(doc, indent=2, allow_nan=False, ensure_ascii=False) + "\n"
+        text = json.dumps(value, indent=2, allow_nan=False, ensure_ascii=False)
     except (TypeError, ValueError) as exc:  # NaN, infinity or a non-JSON object in the parameters
+        raise ValueError(f"the project holds a value JSON cannot store: {exc}") from exc
+    # JSON text holds no raw newline inside a string, so every newline starts a line.
+    return text.replace("\n", "\n" + "  " * level) if level else text
+
+
+#: Encodes one line of a column (the C encoder: no indent).
+_INLINE = json.JSONEncoder(allow_nan=False, ensure_ascii=False)
+_COLUMN_INDENT = "\n" + " " * 8
+_ROW_SEPARATOR = "," + _COLUMN_INDENT
+#: A long column is yielded this many lines at a time.
+_ROWS_PER_PART = 1000
+
+
+def _channel_parts(channel: Channel) -> Iterator[str]:
+    """The fields of one channel, one a line; columns wrapped, long ones in several parts."""
+    sep = ""
+    for name, value in channel.to_dict(columns=True).items():
+        yield f"{sep}      {_INLINE.encode(name)}: "
+        if isinstance(value, list):
+            yield from _column_parts(value)
+        else:
+            yield _INLINE.encode(value)
+        sep = ",\n"
+
+
+def _column_parts(values: list[Any]) -> Iterator[str]:
+    """A column, :data:`NUMBERS_PER_LINE` entries a line (a short one stays on its line)."""
+    step = NUMBERS_PER_LINE
+    if len(values) <= step:
+        yield ("[" + _row_texts(values)[0] + "]") if values else "[]"
+        return
+    yield "[" + _COLUMN_INDENT
+    block = step * _ROWS_PER_PART
+    for start in range(0, len(values), block):
+        text = _ROW_SEPARATOR.join(_row_texts(values[start:start + block]))
+        yield text if start == 0 else _ROW_SEPARATOR + text
+    yield "\n      ]"
+
+
+def _row_texts(values: list[Any]) -> list[str]:
+    """The lines of (part of) a column, without brackets.
+
+    The ``times`` and ``values`` of keys are finite floats, which ``float.__repr__`` writes
+    exactly as JSON does, only faster; anything else goes through the JSON encoder. Short
+    lines keep each call into C short, so that a background save lets the UI thread take
+    the GIL often.
+    """
+    step = NUMBERS_PER_LINE
+    try:
+        try:
+            # A sum of finite floats is NaN or infinite only after an overflow (then the
+            # encoder below decides); a text or None raises TypeError here, an int or a
+            # bool in float.__repr__.
+            if not math.isfinite(sum(values)):
+                raise TypeError("not only finite numbers")
+            return [", ".join(map(float.__repr__, values[i:i + step])) for i in range(0, len(values), step)]
+        except TypeError:
+            return [_INLINE.encode(values[i:i + step])[1:-1] for i in range(0, len(values), step)]
+    except (TypeError, ValueError) as exc:  # keys are always finite; keep the reader's promise anyway
         raise ValueError(f"the project holds a value JSON cannot store: {exc}") from exc
 
 
@@ -95,7 +194,7 @@ def save_project(data: Any, path: str | os.PathLike[str]) -> None:
     if not isinstance(data, ProjectData):
         data = data.to_project_data()
     target = Path(path)
-    write_text_atomic(target, project_to_json(data, target.parent))
+    write_chunks_atomic(target, (part.encode("utf-8") for part in project_json_parts(data, target.parent)))
 
 
 def load_project(path: str | os.PathLike[str]) -> ProjectData:
@@ -201,15 +300,24 @@ def _parse_float(text: str) -> float:
 
 
 def _channel_from_json(d: dict[str, Any]) -> Channel:
+    if "times" in d or "values" in d:  # format 2: columns
+        for name in ("times", "values"):
+            column = d[name]
+            if not isinstance(column, list) or not all(_is_finite_number(x) for x in column):
+                raise ValueError(f"\"{name}\" must be a list of finite numbers")
+        return Channel.from_dict(d)
     keys = d.get("keys", [])
     if not isinstance(keys, list) or not all(isinstance(k, dict) for k in keys):
         raise ValueError("\"keys\" must be a list of objects")
     for k in keys:
         for name in ("t", "v"):
-            value = k[name]
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+            if not _is_finite_number(k[name]):
                 raise ValueError(f"key field {name!r} must be a finite number")
     return Channel.from_dict(d)
+
+
+def _is_finite_number(value: Any) -> bool:
+    return not isinstance(value, bool) and isinstance(value, (int, float)) and math.isfinite(value)
 
 
 def _reject_constant(name: str) -> Any:

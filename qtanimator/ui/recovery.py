@@ -5,11 +5,17 @@ project into the recovery folder (``<settings>/recovery``, under QTANIMATOR_SETT
 when set), next to a small ``.json`` note with the process id and the project's own path.
 Saving, closing or discarding removes both. At start, recovery files whose process is no
 longer running were left by a crash, and the user is asked whether to recover them.
+
+The UI thread only takes a snapshot of the document (a copy of a few dicts); a worker
+thread serialises and writes it (:mod:`qtanimator.document.background_save`), and a timer
+on the UI thread collects the result. One autosave is in flight at a time: a newer one
+supersedes it, and discarding (save, close, New / Open) stops it and removes what it wrote.
 """
 
 from __future__ import annotations
 
 import json
+import logging
 import os
 import time
 import uuid
@@ -20,16 +26,19 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QEvent, QObject, QStandardPaths, QTimer
 from PySide6.QtWidgets import QApplication, QMessageBox
 
+from qtanimator.document.background_save import BackgroundSaver, SaveJob, same_snapshot
 from qtanimator.document.io import open_document, to_project_data
-from qtanimator.formats.atomic import write_text_atomic
 from qtanimator.formats.errors import FormatError
-from qtanimator.formats.project import save_project
 
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
 
 AUTOSAVE_INTERVAL_MS = 60_000
+#: How often the UI thread looks whether the autosave in flight has finished.
+POLL_INTERVAL_MS = 50
 SUFFIX = ".qtanim"
+
+log = logging.getLogger(__name__)
 
 
 def recovery_dir() -> Path:
@@ -121,18 +130,30 @@ class RecoveryManager(QObject):
         stem = f"recovery-{os.getpid()}-{uuid.uuid4().hex[:8]}"
         self.project_path = recovery_dir() / f"{stem}{SUFFIX}"
         self.note_path = recovery_dir() / f"{stem}.json"
-        self._saved_index: int | None = None
+        #: Writes the recovery files on a worker thread (tests swap its ``write_file``).
+        self.saver = BackgroundSaver(name="qtanimator-autosave")
+        #: The last autosave that reached the disk (None once discarded).
+        self._written: SaveJob | None = None
         self.timer = QTimer(self)
         self.timer.setObjectName("autosaveTimer")
         self.timer.setInterval(interval_ms)
         self.timer.timeout.connect(self.autosave)
         self.timer.start()
+        self.poll_timer = QTimer(self)
+        self.poll_timer.setObjectName("autosavePollTimer")
+        self.poll_timer.setInterval(POLL_INTERVAL_MS)
+        self.poll_timer.timeout.connect(self._collect)
         stack = window.ctx.undo_stack
         stack.cleanChanged.connect(self._on_clean_changed)
         window.ctx.documentReset.connect(self._on_reset)
-        project, note = self.project_path, self.note_path
-        # Plain function: runs even while the window is being destroyed.
-        window.destroyed.connect(lambda *_a: _remove_files(project, note))
+        project, note, saver = self.project_path, self.note_path, self.saver
+
+        def window_gone(*_args: object) -> None:
+            # A plain function: runs even while the window is being destroyed.
+            saver.shutdown()
+            _remove_files(project, note)
+
+        window.destroyed.connect(window_gone)
         app = QApplication.instance()
         if app is not None:
             app.aboutToQuit.connect(self.discard)
@@ -142,30 +163,63 @@ class RecoveryManager(QObject):
     def has_unsaved_changes(self) -> bool:
         return not self.window.ctx.undo_stack.isClean()
 
-    def autosave(self) -> bool:
-        """Write the recovery file if there are changes since the last one. True if written."""
+    @property
+    def busy(self) -> bool:
+        """An autosave is being written on the worker thread."""
+        return self.saver.busy
+
+    def autosave(self, wait: bool = False) -> bool:
+        """Save the recovery file if the document changed since the last autosave.
+
+        The UI thread takes a snapshot and returns; the worker thread writes it. Returns
+        True when a save was started, or with ``wait`` (the same path, then blocking until
+        the worker is done) True when it was written.
+        """
+        self._collect()
         if not self.has_unsaved_changes():
             self.discard()
-            return False
-        index = self.window.ctx.undo_stack.index()
-        if index == self._saved_index and self.project_path.is_file():
             return False
         doc = self.window.doc
         try:
             self.window.prepare_save()
+            data = to_project_data(doc)
             self.project_path.parent.mkdir(parents=True, exist_ok=True)
-            save_project(to_project_data(doc), self.project_path)
-            note = {"pid": os.getpid(), "original_path": doc.path, "saved_at": time.time(),
-                    "qtanimator_recovery": 1}
-            write_text_atomic(self.note_path, json.dumps(note, indent=1))
         except (OSError, ValueError):
             return False  # autosave never interrupts work
-        self._saved_index = index
+        latest = self.saver.latest
+        if latest is not None and latest.stopped():
+            latest = None
+        if latest is None and self._written is not None and self.project_path.is_file():
+            latest = self._written
+        if latest is not None and same_snapshot(latest.data, data) and latest.context == doc.path:
+            return False  # being written, or on disk already
+        note = {"pid": os.getpid(), "original_path": doc.path, "saved_at": time.time(),
+                "qtanimator_recovery": 1}
+        job = self.saver.submit(data, self.project_path,
+                                [(self.note_path, json.dumps(note, indent=1).encode("utf-8"))],
+                                context=doc.path)
+        if wait:
+            job.wait()
+            self._collect()
+            return job.written
+        self.poll_timer.start()
         return True
 
+    def _collect(self) -> None:
+        """Take in the autosaves the worker has finished (UI thread)."""
+        for job in self.saver.collect():
+            if job.written and not job.discarded:
+                self._written = job
+            elif job.error is not None:
+                log.warning("autosave failed: %s", job.error)
+        if not self.saver.busy:
+            self.poll_timer.stop()
+
     def discard(self) -> None:
-        """Remove this window's recovery file (after a save, a close, or New / Open)."""
-        self._saved_index = None
+        """Remove this window's recovery file (after a save, a close, or New / Open); an
+        autosave in flight is stopped and what it still writes is removed too."""
+        self._written = None
+        self.saver.discard()
         _remove_files(self.project_path, self.note_path)
 
     def _on_clean_changed(self, clean: bool) -> None:

@@ -12,7 +12,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from qtanimator.core.channel import Channel, Key
+from qtanimator.core.channel import Channel, Interpolation, Key, Tangent
 from qtanimator.document import (
     AddAsset,
     Asset,
@@ -26,7 +26,14 @@ from qtanimator.document import (
 )
 from qtanimator.formats import FormatError, atomic
 from qtanimator.formats.info import summarize
-from qtanimator.formats.project import FORMAT_VERSION, load_project, parse_project
+from qtanimator.formats.project import (
+    FORMAT_VERSION,
+    NUMBERS_PER_LINE,
+    ProjectData,
+    load_project,
+    parse_project,
+    project_to_json,
+)
 
 
 def make_doc(folder: Path) -> Document:
@@ -184,6 +191,21 @@ def variant(**changes: object) -> str:
     (variant(**{"channels__hero//x__keys": [{"t": 10**400, "v": 1}]}), "malformed"),
     (variant(**{"channels__hero//x__keys": [{"t": True, "v": 1}]}), "malformed"),
     (variant(**{"channels__hero//x__keys": [{"t": 0, "v": 1, "in": [1]}]}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0, 1.0], "values": [1.0]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": {}, "values": []}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [True], "values": [1.0]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": ["1"]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0, 0.0], "values": [1.0, 2.0]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [10**400], "values": [1.0]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": [1.0], "in": "sideways"}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": [1.0], "in": ["smooth", "flat"]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": [1.0], "out": None}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": [1.0], "out": [[1.0]]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": [1.0], "interp": ["bezier"]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": [1.0], "broken": 1}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": [1.0], "broken": [None]}}), "malformed"),
+    (variant(**{"channels__hero//x": {"times": [0.0], "values": [1.0], "keys": []}}), "malformed"),
     ('{"format": "qtanimator-project", "version": 1, "parameters": {"x": 1e999}}', "too large"),
     ('{"format": "qtanimator-project", "version": 1, "parameters": {"x": NaN}}', "NaN"),
     ("[" * 100000, "nested too deeply|not valid JSON"),
@@ -321,3 +343,93 @@ def test_view_state_round_trips_apart_from_authored_state(tmp_path):
     path.write_text(text.replace('"view": {', '"view": [{').replace("}\n  }\n}", "}\n  }]\n}"))
     with pytest.raises(FormatError, match='"view" must be an object'):
         open_document(path)
+
+
+# ------------------------------------------------------------------ format 2: key columns
+def test_channels_are_written_as_columns(tmp_path):
+    doc = make_doc(tmp_path)
+    long = Channel([Key(i / 24.0, (-1.0) ** i * i / 7.0) for i in range(2 * NUMBERS_PER_LINE + 3)], "cycle")
+    doc.channels["lamp/bulb/rx"] = long
+    save_document(doc, tmp_path / "scene.qtanim")
+    text = (tmp_path / "scene.qtanim").read_text(encoding="utf-8")
+    channels = json.loads(text)["channels"]
+    assert all("keys" not in ch for ch in channels.values())
+    # Rules every key shares are written once.
+    assert channels["lamp/bulb/rx"] == {"pre": "cycle", "post": "constant", "in": "smooth", "out": "smooth",
+                                        "times": [k.time for k in long.keys], "values": [k.value for k in long.keys]}
+    assert channels["lamp/bulb/rz"] == {"pre": "constant", "post": "constant", "in": "smooth", "out": "smooth",
+                                        "times": [1.0 / 3.0], "values": [-0.1]}
+    # Rules that differ are written per key; a fixed slope is a number.
+    assert channels["lamp//intensity"] == {
+        "pre": "bounce", "post": "cycle_offset", "in": ["flat", "clamped"], "out": [2.5, "linear"],
+        "interp": ["cubic", "constant"], "broken": [False, True], "times": [0.0, 0.5], "values": [1.0, 0.25]}
+    # Long columns are wrapped, NUMBERS_PER_LINE numbers a line; short ones stay on one line.
+    assert '"times": [0.3333333333333333],\n' in text
+    start = text.index('"times": [', text.index('"lamp/bulb/rx"'))
+    column = text[start:text.index("]", start) + 1]
+    rows = column.splitlines()[1:-1]
+    assert [len(r.split(",")) - (1 if r.endswith(",") else 0) for r in rows] == [NUMBERS_PER_LINE] * 2 + [3]
+    assert rows[0].startswith(" " * 8 + "0.0, 0.041666666666666664, ")
+    assert open_document(tmp_path / "scene.qtanim").channels == doc.channels
+
+
+def test_format_1_projects_still_load_and_save_as_format_2(tmp_path):
+    doc = make_doc(tmp_path)
+    save_document(doc, tmp_path / "new.qtanim")
+    old = json.loads((tmp_path / "new.qtanim").read_text(encoding="utf-8"))
+    old["version"] = 1
+    old["channels"] = {cid: Channel.from_dict(ch).to_dict() for cid, ch in old["channels"].items()}
+    assert all("keys" in ch and "times" not in ch for ch in old["channels"].values())
+    (tmp_path / "old.qtanim").write_text(json.dumps(old, indent=2), encoding="utf-8")
+    loaded = open_document(tmp_path / "old.qtanim")
+    assert loaded.state() == doc.state()
+    save_document(loaded, tmp_path / "resaved.qtanim")
+    assert (tmp_path / "resaved.qtanim").read_bytes() == (tmp_path / "new.qtanim").read_bytes()
+
+
+def _bits(x: float) -> str:
+    return float(x).hex()
+
+
+finite = st.floats(allow_nan=False, allow_infinity=False)
+rules = st.sampled_from(["flat", "linear", "smooth", "clamped"]) | finite
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(times=st.lists(finite, min_size=0, max_size=40, unique_by=lambda t: t + 0.0),
+       data=st.data(), shared=st.booleans())
+def test_columns_keep_every_key_exactly(tmp_path, times, data, shared):
+    n = len(times)
+    values = data.draw(st.lists(finite, min_size=n, max_size=n))
+    if shared:
+        one = (data.draw(rules), data.draw(rules), data.draw(st.sampled_from(list(Interpolation))), False)
+        sides = [one] * n
+    else:
+        sides = [(data.draw(rules), data.draw(rules), data.draw(st.sampled_from(list(Interpolation))),
+                  data.draw(st.booleans())) for _ in range(n)]
+    keys = [Key.make(t, v, i, o, interpolation=m, broken=b) for t, v, (i, o, m, b) in zip(times, values, sides)]
+    ch = Channel(keys, data.draw(st.sampled_from(["constant", "linear", "cycle"])), "bounce")
+    project = ProjectData(channels={"a/b/c": ch})
+    text = project_to_json(project, tmp_path)
+    back = parse_project(text, tmp_path / "p.qtanim").channels["a/b/c"]
+    assert back == ch
+    for a, b in zip(ch.keys, back.keys):
+        assert [_bits(a.time), _bits(a.value)] == [_bits(b.time), _bits(b.value)]
+        for side in ("in", "out"):
+            if getattr(a, f"{side}_tangent") is Tangent.FIXED:
+                assert _bits(getattr(a, f"{side}_slope")) == _bits(getattr(b, f"{side}_slope"))
+    assert project_to_json(ProjectData(channels={"a/b/c": back}), tmp_path) == text
+
+
+def test_a_rule_is_shared_only_when_every_key_writes_it_the_same_way():
+    def columns(*slopes: float) -> object:
+        return Channel([Key.make(i, 0.0, s, "flat") for i, s in enumerate(slopes)]).to_dict(columns=True)["in"]
+
+    assert columns(0.5, 0.5, 0.5) == 0.5
+    assert columns(0.0, -0.0) == [0.0, -0.0] and str(columns(0.0, -0.0)) == "[0.0, -0.0]"
+    assert columns(1.0, 2.0) == [1.0, 2.0]
+    ch = Channel([Key(0, 1), Key(1, 2, "smooth", "smooth", 0, 0, "linear")])
+    assert ch.to_dict(columns=True) == {"pre": "constant", "post": "constant", "in": "smooth", "out": "smooth",
+                                        "interp": ["cubic", "linear"], "times": [0.0, 1.0], "values": [1.0, 2.0]}
+    assert Channel().to_dict(columns=True) == {"pre": "constant", "post": "constant", "times": [], "values": []}
+    assert Channel.from_dict(Channel().to_dict(columns=True)) == Channel()
