@@ -21,12 +21,17 @@ from qtanimator.document.document import Document
 
 
 class SetKeySlopes(SetChannels):
-    """Set fixed slopes (value per second) on one key's in and / or out side."""
+    """Set fixed slopes (value per second) on one key's in and / or out side.
+
+    ``base`` is the channel to edit (default: the document's); a handle drag passes the
+    channel as it was when the drag began, so that every mouse move's command is built
+    from the same state.
+    """
 
     def __init__(self, doc: Document, cid: str, index: int, in_slope: float | None = None,
                  out_slope: float | None = None, gesture: Hashable | None = None,
-                 text: str = "Tangent Handle") -> None:
-        old = doc.channels[cid]
+                 text: str = "Tangent Handle", base: Channel | None = None) -> None:
+        old = doc.channels[cid] if base is None else base
         key = old.keys[index]
         if in_slope is not None:
             key = replace(key, in_tangent=Tangent.FIXED, in_slope=float(in_slope))

@@ -1,8 +1,6 @@
-"""The curve editor's Qt-free commands (qtanimator.document.curve_commands) and sampling cache."""
+"""The curve editor's Qt-free commands (qtanimator.document.curve_commands) and normalisation."""
 
 from __future__ import annotations
-
-import math
 
 import numpy as np
 import pytest
@@ -13,7 +11,7 @@ from qtanimator.core.channel import Channel, Extrapolation, Key, Tangent
 from qtanimator.document import Document, UndoStack
 from qtanimator.document.commands import MoveKeys
 from qtanimator.document.curve_commands import SetKeysBroken, SetKeySlopes
-from qtanimator.ui.curves.sampling import SampleCache, channel_normalisation, sample_channel
+from qtanimator.ui.curves.normalisation import NormalisationCache, channel_normalisation
 
 RULES = ["flat", "linear", "smooth", "clamped"]
 tangent = st.one_of(st.sampled_from(RULES), st.floats(-10, 10, allow_nan=False))
@@ -96,30 +94,16 @@ def test_set_key_slopes_and_break_unify():
     assert doc.channels["c//x"] == ch
 
 
-def test_sampling_covers_the_view_and_caches_by_identity():
-    ch = Channel([Key(0.5, 1.0), Key(1.0, 3.0)], pre="linear", post="cycle")
-    s = sample_channel(ch, 60.0, 0.0, 120.0, 200)
-    assert s.x[0] == 30.0 and s.x[-1] == 60.0
-    assert s.ext_x[0] == 0.0 and s.ext_x[-1] == 120.0 and math.isnan(s.ext_x[2])  # 2-point linear pre
-    assert np.allclose(s.y, ch.evaluate(s.x / 60.0))
-    valid = ~np.isnan(s.ext_x)
-    assert np.allclose(s.ext_y[valid], ch.evaluate(s.ext_x[valid] / 60.0))
-    cache = SampleCache()
-    a = cache.get("c//x", ch, 60.0, 0.0, 120.0, 200)
-    assert cache.get("c//x", ch, 60.0, 0.0, 120.0, 200) is a
-    equal_but_new = Channel(ch.keys, ch.pre, ch.post)
-    assert cache.get("c//x", equal_but_new, 60.0, 0.0, 120.0, 200) is not a
-    assert cache.sampled == 2
-
-
-def test_stepped_span_is_drawn_upright_and_normalisation():
+def test_normalisation_maps_the_keyed_range_to_minus_one_one_and_caches_by_identity():
     from qtanimator.core.channel import Interpolation
 
     ch = Channel([Key(0.0, 0.0, interpolation=Interpolation.CONSTANT), Key(1.0, 4.0), Key(2.0, 2.0)])
-    s = sample_channel(ch, 10.0, 0.0, 20.0, 50)
-    i = int(np.searchsorted(s.x, 10.0))
-    assert s.y[i - 1] == 0.0 and s.y[i] == 4.0 and s.x[i] - s.x[i - 1] < 1e-5
     off, scale = channel_normalisation(ch)
     v = (ch.evaluate(np.linspace(0, 2, 1001)) - off) * scale
     assert v.min() == pytest.approx(-1, abs=1e-3) and v.max() == pytest.approx(1, abs=1e-3)
     assert channel_normalisation(Channel([Key(0, 5.0)])) == (5.0, 1.0)
+    cache = NormalisationCache()
+    assert cache.get("c//x", ch) == (off, scale)
+    cache._entries["c//x"] = (ch, 7.0, 3.0)  # a hit returns the stored entry
+    assert cache.get("c//x", ch) == (7.0, 3.0)
+    assert cache.get("c//x", Channel(ch.keys)) == (off, scale)  # an equal but new object: computed again

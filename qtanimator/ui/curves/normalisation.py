@@ -1,0 +1,50 @@
+"""Display-only normalisation of curves: each channel's keyed range scaled to −1…1.
+
+Channels are immutable, so a channel's ``(offset, scale)`` is cached per channel object.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from qtanimator.core.channel import Channel
+
+
+class NormalisationCache:
+    """``(offset, scale)`` per channel id, valid while the channel object is the same."""
+
+    def __init__(self) -> None:
+        self._entries: dict[str, tuple[Channel, float, float]] = {}
+
+    def get(self, cid: str, channel: Channel) -> tuple[float, float]:
+        """``(offset, scale)`` so that ``(value - offset) * scale`` spans −1…1 over the keyed range."""
+        hit = self._entries.get(cid)
+        if hit is not None and hit[0] is channel:
+            return hit[1], hit[2]
+        offset, scale = channel_normalisation(channel)
+        self._entries[cid] = (channel, offset, scale)
+        return offset, scale
+
+    def drop(self, cid: str) -> None:
+        self._entries.pop(cid, None)
+
+    def clear(self) -> None:
+        self._entries.clear()
+
+
+def channel_normalisation(channel: Channel) -> tuple[float, float]:
+    """Offset and scale mapping the channel's values between its first and last key to −1…1."""
+    if not channel.keys:
+        return 0.0, 1.0
+    times = channel.times
+    if len(times) > 1:
+        t = np.concatenate([np.linspace(times[0], times[-1], 256), times])
+        v = channel.evaluate(t)
+    else:
+        v = channel.values
+    lo, hi = float(np.min(v)), float(np.max(v))
+    half = 0.5 * (hi - lo)
+    mid = 0.5 * (hi + lo)
+    if half <= 1e-12 * max(1.0, abs(mid)):
+        return mid, 1.0
+    return mid, 1.0 / half
