@@ -130,13 +130,21 @@ class Shooter:
                 return
         raise KeyError(title)
 
-    def grab_window(self, name: str) -> None:
+    def _settle_and_grab(self, widget):  # type: ignore[no-untyped-def]
+        """The widget's picture once the cloth is simulated (3D views drawn in)."""
+        from qtanimator.document.cloth_worker import cloth_worker
+        from qtanimator.ui.viewport import grab_with_3d
+
+        cloth_worker(self.ctx.doc).wait(120)
+        self.window.viewport3d.update()
         settle(self.app, 0.5)
-        save_png(self.window.grab(), self.out / f"{name}.png")
+        return grab_with_3d(widget)
+
+    def grab_window(self, name: str) -> None:
+        save_png(self._settle_and_grab(self.window), self.out / f"{name}.png")
 
     def grab_widget(self, widget, name: str, max_width: int = MAX_WIDTH) -> None:  # type: ignore[no-untyped-def]
-        settle(self.app, 0.5)
-        save_png(widget.grab(), self.out / f"{name}.png", max_width)
+        save_png(self._settle_and_grab(widget), self.out / f"{name}.png", max_width)
 
     # -------------------------------------------------------------- 2D
     def main_window(self) -> None:

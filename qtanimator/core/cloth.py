@@ -47,7 +47,7 @@ deterministic: the same parameters and calls give bit-identical arrays.
 from __future__ import annotations
 
 import math
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field, fields, replace
 from typing import Any, NamedTuple
 
@@ -62,7 +62,8 @@ BoolArray = npt.NDArray[np.bool_]
 
 __all__ = [
     "INTEGRATORS", "PARAM_RANGES", "PIN_MODES", "SPRING_KINDS", "Cloth", "ClothBlowUp", "ClothParams", "ClothState",
-    "Sphere", "grid_index", "pins_from_cells", "rotation_matrix", "vertex_normals",
+    "ClothStepCancelled", "Sphere", "grid_index", "nearest_particle", "pins_from_cells", "rotation_matrix",
+    "vertex_normals",
 ]
 
 PIN_MODES = ("top_corners", "top_edge", "none", "custom")
@@ -285,6 +286,11 @@ class ClothBlowUp(RuntimeError):
         self.time = time
 
 
+class ClothStepCancelled(Exception):
+    """:meth:`Cloth.step` was asked to stop between two substeps; the cloth is back in the
+    state from before the step, so stepping again later gives the same frames."""
+
+
 @dataclass
 class ClothState:
     """Everything that evolves: enough to resume a simulation exactly (caches keep these)."""
@@ -426,6 +432,15 @@ class Cloth:
         self._turb_phase = rng.uniform(0.0, 2 * math.pi, size=(4, 3))
         self._implicit_cache: dict[str, Any] | None = None
         self._air: FloatArray | None = None
+        self._wind_cache: FloatArray | None = None
+        self._inv_mass_h: tuple[float, FloatArray] | None = None
+
+    def _wind_field(self) -> FloatArray:
+        """The steady wind at every particle, (N, 3) (the fused kernel wants an array)."""
+        wind = np.asarray(self.params.wind, dtype=np.float64)
+        if self._wind_cache is None or not np.array_equal(self._wind_cache[0], wind):
+            self._wind_cache = np.ascontiguousarray(np.broadcast_to(wind, (self.n, 3)))
+        return self._wind_cache
 
     def _set_spring_constants(self) -> None:
         p = self.params
@@ -584,24 +599,17 @@ class Cloth:
 
         With ``max_distance`` only particles that close to the ray count.
         """
-        o = np.asarray(ray_origin, dtype=np.float64).reshape(3)
-        d = np.asarray(ray_dir, dtype=np.float64).reshape(3)
-        norm = float(np.linalg.norm(d))
-        if not norm > 0:
-            return None
-        d = d / norm
-        w = self.positions - o
-        along = w @ d
-        dist2 = np.einsum("ij,ij->i", w, w) - along * along
-        dist2[along < 0] = np.inf
-        i = int(np.argmin(dist2))
-        if not np.isfinite(dist2[i]):
-            return None
-        if max_distance is not None and dist2[i] > max_distance * max_distance:
-            return None
-        self.grabbed = i
-        self._grab_target = self.positions[i].copy()
+        i = nearest_particle(self.positions, ray_origin, ray_dir, max_distance)
+        if i is not None:
+            self.grab_particle(i)
         return i
+
+    def grab_particle(self, index: int) -> None:
+        """Grab particle ``index`` where it is now (:meth:`drag_grabbed` then moves it)."""
+        if not 0 <= index < self.n:
+            raise ValueError(f"particle {index} is outside the cloth's {self.n} particles")
+        self.grabbed = int(index)
+        self._grab_target = self.positions[index].copy()
 
     def drag_grabbed(self, target: Any) -> None:
         """Move the grabbed particle to ``target`` during the next step (no-op without a grab)."""
@@ -618,11 +626,14 @@ class Cloth:
         self._grab_target = None
 
     # ----------------------------------------------------------- simulation
-    def step(self, dt: float = 1.0 / 60.0) -> None:
+    def step(self, dt: float = 1.0 / 60.0, should_stop: Callable[[], bool] | None = None) -> None:
         """Advance one display frame of ``dt`` seconds (``params.substeps`` substeps inside).
 
         Raises ClothBlowUp (and keeps the state from before the frame) when the simulation
-        goes unstable; raises it again on every later step until reset.
+        goes unstable; raises it again on every later step until reset. ``should_stop`` is
+        asked before every substep; when it answers True the cloth goes back to the state
+        from before the frame and :class:`ClothStepCancelled` is raised (a worker thread
+        cancels a long implicit step this way, and resuming later gives identical frames).
         """
         if self.error is not None:
             raise self.error
@@ -637,6 +648,10 @@ class Cloth:
         self._air = self._wind_at(self.positions) if self.params.turbulence > 0 else None
         with np.errstate(all="ignore"):
             for s in range(1, substeps + 1):
+                if should_stop is not None and should_stop():
+                    self.set_state(saved)
+                    self._air = None
+                    raise ClothStepCancelled(f"cloth step cancelled at t = {self.time:.4f} s")
                 kin_pos = kin_end if s == substeps else kin_start + (kin_end - kin_start) * (s / substeps)
                 if self.params.integrator == "implicit":
                     self._implicit_substep(h, kin_idx, kin_pos, kin_vel)
@@ -742,6 +757,19 @@ class Cloth:
 
     def _symplectic_substep(self, h: float, kin_idx: IntArray, kin_pos: FloatArray, kin_vel: FloatArray) -> None:
         x, v = self.positions, self.velocities
+        if self.accelerated:
+            # Forces and the update in one compiled pass that releases the GIL.
+            p = self.params
+            coef = 0.5 * p.air_density * p.drag_coefficient
+            air = self._air if self._air is not None else self._wind_field()
+            if self._inv_mass_h is None or self._inv_mass_h[0] != h:
+                self._inv_mass_h = (h, self._inv_mass * h)
+            cloth_kernels.symplectic_substep(x, v, air, self._si, self._sj, self.rest_lengths, self._spring_k,
+                                             self._spring_c, self.triangles, coef, p.gravity * self.particle_mass,
+                                             self._inv_mass_h[1], h, kin_idx, np.ascontiguousarray(kin_pos),
+                                             np.ascontiguousarray(kin_vel), self._force)
+            self._collide(kin_idx)
+            return
         force = self._external_forces(x, v)
         self._spring_forces(x, v, force)
         force *= self._inv_mass[:, None] * h
@@ -953,6 +981,31 @@ def vertex_normals(positions: FloatArray, triangles: IntArray, fallback: Any = (
     vn[ok] /= length[ok, None]
     vn[~ok] = np.asarray(fallback, dtype=np.float64)
     return vn
+
+
+def nearest_particle(positions: FloatArray, ray_origin: Any, ray_dir: Any,
+                     max_distance: float | None = None) -> int | None:
+    """The particle nearest to a ray (in front of its origin), or None.
+
+    With ``max_distance`` only particles that close to the ray count. :meth:`Cloth.grab`
+    uses it; a viewer holding a snapshot of the positions can pick with it too.
+    """
+    o = np.asarray(ray_origin, dtype=np.float64).reshape(3)
+    d = np.asarray(ray_dir, dtype=np.float64).reshape(3)
+    norm = float(np.linalg.norm(d))
+    if not norm > 0 or len(positions) == 0:
+        return None
+    d = d / norm
+    w = np.asarray(positions, dtype=np.float64) - o
+    along = w @ d
+    dist2 = np.einsum("ij,ij->i", w, w) - along * along
+    dist2[along < 0] = np.inf
+    i = int(np.argmin(dist2))
+    if not np.isfinite(dist2[i]):
+        return None
+    if max_distance is not None and dist2[i] > max_distance * max_distance:
+        return None
+    return i
 
 
 def grid_index(cols: int, row: int, col: int) -> int:

@@ -22,8 +22,11 @@ named preset (``physical`` or ``handout``).
 from __future__ import annotations
 
 import math
+import threading
+import time
 import weakref
-from collections.abc import Hashable, Iterable
+from collections import Counter
+from collections.abc import Callable, Hashable, Iterable
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +39,7 @@ from qtanimator.core.pendulum import PRESETS, PendulumParams, PendulumSystem
 from qtanimator.core.rig2d import Character, Pose
 from qtanimator.document.commands import AddAsset, Command, DeleteKeys, Macro, SetKeys, SetParameter
 from qtanimator.document.document import Asset, Document, DocumentChange, channel_id, split_channel_id
+from qtanimator.document.simulation import SimulationWorker
 
 ASSET_KIND = "character2d"
 KEY_ALL_PARAMETER = "animation.key_all"
@@ -153,21 +157,28 @@ def _local_from_world_dynamic(ch: Character, angles: FloatArray, dyn_world: Floa
     return out
 
 
-def joint_angles(doc: Document, asset_id: str, time: float) -> FloatArray:
+def joint_angles(doc: Document, asset_id: str, time: float, block: bool = True) -> FloatArray:
     """Local angles (J,) at ``time``: channels for keyframed joints, the simulation for
-    dynamic ones."""
+    dynamic ones. ``block`` False (views): the latest simulated state, never stepping on
+    this thread (see :meth:`PendulumCache.latest_state`)."""
     ch = character(doc, asset_id)
     angles = keyframed_angles(doc, asset_id, time)
     if ch.dynamic.any():
-        world = simulation(doc).world_angles(asset_id, time)
+        world = simulation(doc).world_angles(asset_id, time, wait=block)
         angles = _local_from_world_dynamic(ch, angles, world)
     return angles
 
 
-def evaluate_pose(doc: Document, asset_id: str, time: float) -> Pose:
-    """The character's pose at ``time`` (keyframes, pendulums and translation)."""
+def evaluate_pose(doc: Document, asset_id: str, time: float, block: bool = True) -> Pose:
+    """The character's pose at ``time`` (keyframes, pendulums and translation).
+
+    ``block`` True is exact: pendulum frames not simulated yet are simulated on the calling
+    thread (render, export, commands). ``block`` False is for views: the pendulums show the
+    latest state the background worker has (exact once it has caught up); nothing is
+    simulated on the calling thread.
+    """
     ch = character(doc, asset_id)
-    return ch.pose(joint_angles(doc, asset_id, time), translation(doc, asset_id, time))
+    return ch.pose(joint_angles(doc, asset_id, time, block), translation(doc, asset_id, time))
 
 
 # ------------------------------------------------------------------- key edits
@@ -207,10 +218,11 @@ def key_joint(doc: Document, asset_id: str, joint_index: int, angle: float, time
     ch = character(doc, asset_id)
     j = ch.joints[joint_index]
     value = float(angle)
-    if j.is_dynamic:
-        pose = evaluate_pose(doc, asset_id, time)
-        parent = 0.0 if j.parent is None else float(pose.world_angles[j.parent])
-        value = parent + value
+    if j.is_dynamic and j.parent is not None:
+        # The parent's world angle needs the simulation only under a dynamic ancestor.
+        exact = bool(ch.dynamic[ch.ancestors(j.parent)].any())
+        angles = joint_angles(doc, asset_id, time) if exact else keyframed_angles(doc, asset_id, time)
+        value = float(ch.pose(angles).world_angles[j.parent]) + value
     return _set_keys(doc, {angle_channel_id(asset_id, j.name): _key(time, value)},
                      f"Rotate {j.name}", gesture)
 
@@ -275,7 +287,8 @@ def delete_keys_at(doc: Document, asset_id: str | None, time: float) -> Command 
 # -------------------------------------------------------------- pendulum params
 def pendulum_params(doc: Document, asset_id: str) -> PendulumParams:
     prefix = f"{asset_id}.pendulum."
-    values = {k[len(prefix):]: v for k, v in doc.parameters.items() if k.startswith(prefix)}
+    # list() copies in one step: the simulation worker may read while the UI thread edits.
+    values = {k[len(prefix):]: v for k, v in list(doc.parameters.items()) if k.startswith(prefix)}
     preset = PRESETS.get(str(values.pop("preset", "physical")), PRESETS["physical"])
     try:
         return PendulumParams.from_dict({**preset.to_dict(), **values})
@@ -309,6 +322,8 @@ class _AssetSim:
         self.system = PendulumSystem(ch, params)
         self.theta: list[FloatArray] = []  # per frame (world angles, J)
         self.omega: list[FloatArray] = []
+        #: Bumped by an invalidation that reaches the frame being computed (see PendulumCache).
+        self.generation = 0
         n = len(ch.joints)
         key_sum = np.zeros((n, n))
         dyn_pick = np.zeros((n, n))
@@ -346,18 +361,73 @@ class PendulumCache:
     """Per-frame pendulum states of every 2D character, at a fixed internal step.
 
     Frame f (from the project's ``frame_start``) holds the world angles after simulating up
-    to time f / fps. Asking for a later frame steps the simulation forward from the last
-    cached frame; an earlier one reads the cache. A channel edit drops the frames after the
-    edited time; a parameter or asset change drops that character's frames.
+    to time f / fps. A channel edit drops the frames from the edited time on (once per asset
+    and change); a parameter or asset change drops that character's frames.
+
+    Two ways to read:
+
+    * exact (``state``, ``world_angles(..., wait=True)``): a frame not cached yet is
+      simulated on the calling thread (headless render, export, commands, tests);
+    * latest (``latest_state``, ``world_angles(..., wait=False)``): never steps; returns the
+      last frame simulated at or before the one asked for (the keyed start state when
+      nothing is), and asks the background worker (:mod:`qtanimator.document.simulation`)
+      to fill up to that frame plus :attr:`LOOKAHEAD` seconds. Views use this.
+
+    Threads: the worker and exact reads compute a frame without the lock and append it
+    under the lock only if the character's simulation is still the same object, its
+    ``generation`` unchanged (an invalidation that reaches the frame being computed bumps
+    it) and the frame still the next one; so a frame computed from a dropped state never
+    enters the cache, and every cached frame equals the synchronous result exactly.
     """
 
     MAX_FRAMES = 200_000
+    #: Seconds of frames the worker simulates past the frame a view asked for.
+    LOOKAHEAD = 1.0
 
     def __init__(self, doc: Document) -> None:
         self._doc = weakref.ref(doc)
         self._sims: dict[str, _AssetSim] = {}
+        self._lock = threading.Lock()
+        self._epoch = 0  # bumped when simulations are dropped (a sim built meanwhile is stale)
+        self._targets: dict[str, int] = {}  # frame index the worker fills each character to
+        #: Sub-steps simulated (by any thread), and per thread id (frames later discarded included).
         self.steps_taken = 0
+        self.steps_by_thread: Counter[int] = Counter()
+        #: Frame-dropping invalidations (one per character per change at most), and restarts
+        #: (worker wake-ups caused by a change: at most one per change).
+        self.invalidations = 0
+        self.restarts = 0
+        #: Changes whenever frames are added or dropped (the UI polls it).
+        self.revision = 0
+        self._worker = SimulationWorker(self._work, "pendulums")
+        weakref.finalize(self, self._worker.shutdown, 0.0)
         doc.subscribe(self._on_change)
+
+    # ---- worker control
+    @property
+    def worker(self) -> SimulationWorker:
+        return self._worker
+
+    @property
+    def busy(self) -> bool:
+        """True while the worker has frames to simulate."""
+        return self._worker.busy
+
+    def shutdown(self, timeout: float | None = 5.0) -> None:
+        """Stop the worker thread and forget what it was asked for (cached frames stay;
+        a later latest-state read starts it again)."""
+        with self._lock:
+            self._targets.clear()
+        self._worker.shutdown(timeout)
+
+    def wait_idle(self, timeout: float = 30.0) -> bool:
+        """Block until the worker has nothing to do (tests); False on timeout."""
+        deadline = time.monotonic() + timeout
+        while self._worker.busy:
+            if time.monotonic() > deadline:
+                return False
+            time.sleep(0.001)
+        return True
 
     # ---- invalidation
     def _on_change(self, change: DocumentChange) -> None:
@@ -365,102 +435,270 @@ class PendulumCache:
         if doc is None:
             return
         if change.reset:
-            self._sims.clear()
+            with self._lock:
+                self._drop_all()
+                self._targets.clear()
+            self._worker.shutdown()
             return
-        for asset_id in change.assets:
-            self._sims.pop(asset_id, None)
-        for path in change.parameters:
-            if path in ("fps", "frame_start") or path.startswith("simulation."):
-                self._sims.clear()
-            elif ".pendulum." in path:
-                self._sims.pop(path.split(".pendulum.", 1)[0], None)
-        for asset_id in change.channel_assets():
-            # One invalidation per asset and command, from its earliest edited time.
-            self.invalidate(asset_id, change.channel_time_from(asset_id))
+        dropped = False
+        with self._lock:
+            for asset_id in change.assets:
+                dropped |= self._drop(asset_id)
+                if asset_id not in doc.assets:
+                    self._targets.pop(asset_id, None)
+            for path in change.parameters:
+                if path in ("fps", "frame_start") or path.startswith("simulation."):
+                    dropped |= self._drop_all()
+                elif ".pendulum." in path:
+                    dropped |= self._drop(path.split(".pendulum.", 1)[0])
+            for asset_id in change.channel_assets():
+                # One invalidation per asset and command, from its earliest edited time.
+                dropped |= self._invalidate_locked(doc, asset_id, change.channel_time_from(asset_id))
+            restart = dropped and bool(self._targets)
+            if restart:
+                self.restarts += 1
+        if restart:
+            self._worker.wake()
+
+    def _drop(self, asset_id: str) -> bool:
+        self._epoch += 1  # also when none is cached: one may be under construction
+        if self._sims.pop(asset_id, None) is None:
+            return False
+        self.revision += 1
+        self.invalidations += 1
+        return True
+
+    def _drop_all(self) -> bool:
+        self._epoch += 1
+        if not self._sims:
+            return False
+        self._sims.clear()
+        self.revision += 1
+        self.invalidations += 1
+        return True
+
+    def _invalidate_locked(self, doc: Document | None, asset_id: str, time_from: float) -> bool:
+        sim = self._sims.get(asset_id)
+        if sim is None or time_from == math.inf:
+            return False
+        if doc is None or time_from == -math.inf:
+            return self._drop(asset_id)
+        # Frame i (after the start) integrates inputs at times before its own time and
+        # applies keys at its own time, so it is valid while its time < time_from.
+        keep = max(math.ceil(time_from * doc.fps - doc.frame_range[0] - 1e-9), 0)
+        if keep > len(sim.theta):
+            return False  # neither a cached frame nor the one being computed is affected
+        # The frame being computed (index len) may read the old inputs: make it stale too.
+        sim.generation += 1
+        del sim.theta[keep:]
+        del sim.omega[keep:]
+        self.revision += 1
+        self.invalidations += 1
+        return True
 
     def invalidate(self, asset_id: str | None = None, time_from: float = -math.inf) -> None:
         """Drop the cached frames whose state depends on inputs at or after ``time_from``
-        (every character's with ``asset_id`` None)."""
+        (every character's with ``asset_id`` None); the worker refills what views asked for."""
         doc = self._doc()
-        targets = list(self._sims) if asset_id is None else [asset_id]
-        for aid in targets:
-            sim = self._sims.get(aid)
-            if sim is None or time_from == math.inf:
-                continue
-            if doc is None or time_from == -math.inf:
-                del self._sims[aid]
-                continue
-            # Frame i (after the start) integrates inputs at times before its own time and
-            # applies keys at its own time, so it is valid while its time < time_from.
-            keep = max(math.ceil(time_from * doc.fps - doc.frame_range[0] - 1e-9), 0)
-            if keep < len(sim.theta):
-                del sim.theta[keep:]
-                del sim.omega[keep:]
+        with self._lock:
+            targets = list(self._sims) if asset_id is None else [asset_id]
+            dropped = False
+            for aid in targets:
+                dropped |= self._invalidate_locked(doc, aid, time_from)
+            restart = dropped and bool(self._targets)
+        if restart:
+            self._worker.wake()
 
     def cached_frames(self, asset_id: str) -> int:
         sim = self._sims.get(asset_id)
         return 0 if sim is None else len(sim.theta)
 
-    # ---- reads
+    # ---- exact reads
     def _sim(self, doc: Document, asset_id: str) -> _AssetSim:
-        sim = self._sims.get(asset_id)
-        if sim is None:
-            sim = _AssetSim(character(doc, asset_id), pendulum_params(doc, asset_id))
-            self._sims[asset_id] = sim
-        return sim
+        while True:
+            with self._lock:
+                sim = self._sims.get(asset_id)
+                epoch = self._epoch
+            if sim is not None:
+                return sim
+            built = _AssetSim(character(doc, asset_id), pendulum_params(doc, asset_id))
+            with self._lock:
+                if self._epoch == epoch:  # else a change dropped it meanwhile: build again
+                    return self._sims.setdefault(asset_id, built)
+
+    def _index(self, doc: Document, frame: int) -> int:
+        return min(max(int(frame) - doc.frame_range[0], 0), self.MAX_FRAMES)
 
     def state(self, asset_id: str, frame: int) -> tuple[FloatArray, FloatArray]:
-        """World angles and rates (J,) of every joint's pendulum state at an integer frame."""
+        """World angles and rates (J,) of every joint's pendulum state at an integer frame,
+        simulated on the calling thread if not cached yet (exact)."""
         doc = self._doc()
         if doc is None:
             raise RuntimeError("the document is gone")
-        sim = self._sim(doc, asset_id)
-        start = doc.frame_range[0]
-        f = min(max(int(frame) - start, 0), self.MAX_FRAMES)
-        if not sim.theta:
-            theta, omega = self._initial(doc, asset_id, sim)
-            sim.theta.append(theta)
-            sim.omega.append(omega)
-        while len(sim.theta) <= f:
-            i = len(sim.theta)
-            theta, omega = self._advance(doc, asset_id, sim, start + i - 1, sim.theta[-1], sim.omega[-1])
-            sim.theta.append(theta)
-            sim.omega.append(omega)
-        return sim.theta[f], sim.omega[f]
+        f = self._index(doc, frame)
+        while True:
+            sim = self._sim(doc, asset_id)
+            with self._lock:
+                n = len(sim.theta)
+                if n > f:
+                    return sim.theta[f], sim.omega[f]
+                gen = sim.generation
+                prev = (sim.theta[-1], sim.omega[-1]) if n else None
+            self._step(doc, asset_id, sim, gen, n, prev)
 
-    def world_angles(self, asset_id: str, time: float) -> FloatArray:
-        """Dynamic joints' world angles at ``time`` (linear between cached frames)."""
+    def world_angles(self, asset_id: str, time: float, wait: bool = True) -> FloatArray:
+        """Dynamic joints' world angles at ``time`` (linear between cached frames).
+
+        ``wait`` True: exact, simulating on this thread as needed. False: never steps;
+        the latest state available (see :meth:`latest_state`), and the worker is asked to
+        catch up.
+        """
         doc = self._doc()
         if doc is None:
             raise RuntimeError("the document is gone")
         fr = time * doc.fps
         f0 = math.floor(fr + 1e-9)
         u = fr - f0
-        th0 = self.state(asset_id, f0)[0]
+        if wait:
+            th0 = self.state(asset_id, f0)[0]
+            if u <= 1e-9:
+                return th0.copy()
+            th1 = self.state(asset_id, f0 + 1)[0]
+            return np.asarray((1 - u) * th0 + u * th1, dtype=np.float64)
         if u <= 1e-9:
-            return th0.copy()
-        th1 = self.state(asset_id, f0 + 1)[0]
+            return self.latest_state(asset_id, f0)[0].copy()
+        th1, _om, at = self.latest_state(asset_id, f0 + 1)
+        th0, _om, at0 = self.latest_state(asset_id, f0)
+        if at < f0 + 1 or at0 < f0:
+            return th0.copy()  # f0 + 1 is not simulated yet: the latest state at or before f0
         return np.asarray((1 - u) * th0 + u * th1, dtype=np.float64)
 
-    # ---- stepping
+    # ---- latest reads (views)
+    def latest_state(self, asset_id: str, frame: int) -> tuple[FloatArray, FloatArray, int]:
+        """``(theta, omega, shown_frame)``: the state at ``frame`` if simulated, else at the
+        last simulated frame before it (``shown_frame`` says which), or the keyed start
+        state when nothing is. Never simulates on the calling thread; asks the worker to
+        fill up to ``frame`` plus the look-ahead."""
+        doc = self._doc()
+        if doc is None:
+            raise RuntimeError("the document is gone")
+        start = doc.frame_range[0]
+        f = self._index(doc, frame)
+        with self._lock:
+            sim = self._sims.get(asset_id)
+            n = 0 if sim is None else len(sim.theta)
+            if n:
+                assert sim is not None
+                k = min(f, n - 1)
+                theta, omega = sim.theta[k], sim.omega[k]
+            wake = self._request(doc, asset_id, f, n)
+        if wake:
+            self._worker.wake()
+        if n:
+            return theta, omega, start + k
+        ch = character(doc, asset_id)
+        theta = _initial_angles(doc, asset_id, ch, start / doc.fps)
+        return theta, np.zeros(len(ch.joints)), start
+
+    def ready(self, asset_id: str, time: float) -> bool:
+        """True when ``world_angles(asset_id, time, wait=False)`` is exact (its frames are
+        simulated)."""
+        doc = self._doc()
+        if doc is None:
+            return False
+        fr = time * doc.fps
+        f0 = math.floor(fr + 1e-9)
+        need = self._index(doc, f0 + (0 if fr - f0 <= 1e-9 else 1))
+        return self.cached_frames(asset_id) > need
+
+    def _request(self, doc: Document, asset_id: str, index: int, cached: int) -> bool:
+        """Record that a view shows frame ``index`` (lock held); True if the worker must be
+        woken (its target moved and frames up to it are missing)."""
+        first, last = doc.frame_range
+        end = max(last - first, 0)
+        ahead = int(math.ceil(self.LOOKAHEAD * doc.fps))
+        want = max(index, min(index + ahead, end))
+        old = self._targets.get(asset_id, -1)
+        # Grow with the frame shown (playback stays ahead); start over when the view jumped
+        # far back (a scrub), so the worker does not fill frames nobody looks at.
+        changed = want > old or old > index + 2 * ahead
+        if changed:
+            self._targets[asset_id] = want
+        # Wake it when frames are missing and it is not already on them (or was cancelled).
+        return cached <= self._targets[asset_id] and (changed or not self._worker.busy)
+
+    # ---- stepping (any thread)
+    def _work(self, should_stop: Callable[[], bool]) -> bool:
+        """The worker's job: simulate one frame of the character furthest behind its
+        target. False when every target is reached."""
+        doc = self._doc()
+        if doc is None:
+            return False
+        with self._lock:
+            best: tuple[int, str] | None = None
+            for aid, target in list(self._targets.items()):
+                sim = self._sims.get(aid)
+                n = 0 if sim is None else len(sim.theta)
+                if n <= target and (best is None or n < best[0]):
+                    best = (n, aid)
+            if best is None:
+                return False
+            n, aid = best
+            sim = self._sims.get(aid)
+            epoch = self._epoch
+            gen = -1 if sim is None else sim.generation
+            prev = (sim.theta[-1], sim.omega[-1]) if sim is not None and n else None
+        if should_stop():
+            return False
+        if sim is None:
+            ch = doc.runtime.get(aid)
+            if not isinstance(ch, Character):  # removed, or not loaded: nothing to simulate
+                with self._lock:
+                    self._targets.pop(aid, None)
+                return True
+            built = _AssetSim(ch, pendulum_params(doc, aid))
+            with self._lock:
+                if self._epoch == epoch and aid not in self._sims:
+                    self._sims[aid] = built
+            return True
+        self._step(doc, aid, sim, gen, n, prev)
+        return True
+
+    def _step(self, doc: Document, asset_id: str, sim: _AssetSim, generation: int, index: int,
+              prev: tuple[FloatArray, FloatArray] | None) -> bool:
+        """Compute frame ``index`` from ``prev`` (frame ``index - 1``) without the lock and
+        append it if nothing invalidated it meanwhile. True if it was appended."""
+        start = doc.frame_range[0]
+        if prev is None:
+            theta, omega = self._initial(doc, asset_id, sim)
+            steps = 0
+        else:
+            theta, omega, steps = self._advance(doc, asset_id, sim, start + index - 1, prev[0], prev[1])
+        ident = threading.get_ident()
+        with self._lock:
+            self.steps_taken += steps
+            self.steps_by_thread[ident] += steps
+            if self._sims.get(asset_id) is not sim or sim.generation != generation or len(sim.theta) != index:
+                return False
+            sim.theta.append(theta)
+            sim.omega.append(omega)
+            self.revision += 1
+            return True
+
     def _initial(self, doc: Document, asset_id: str, sim: _AssetSim) -> tuple[FloatArray, FloatArray]:
         ch = sim.system.character
         t0 = doc.frame_range[0] / doc.fps
-        theta = np.zeros(len(ch.joints))
-        for k, j in enumerate(ch.joints):
-            if j.is_dynamic:
-                cid = angle_channel_id(asset_id, j.name)
-                if cid in doc.channels and doc.channels[cid].keys:
-                    theta[k] = _value(doc, cid, t0)
-        return theta, np.zeros(len(ch.joints))
+        return _initial_angles(doc, asset_id, ch, t0), np.zeros(len(ch.joints))
 
     def _advance(self, doc: Document, asset_id: str, sim: _AssetSim, frame: int, theta0: FloatArray,
-                 omega0: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """The state at ``frame + 1`` from the state at ``frame``."""
+                 omega0: FloatArray) -> tuple[FloatArray, FloatArray, int]:
+        """The state at ``frame + 1`` from the state at ``frame``, and the sub-steps taken.
+        Reads the document only through atomic lookups (it may run on the worker thread)."""
         system = sim.system
         ch = system.character
         params = system.params
         fps = doc.fps
+        channels = doc.channels
         t0, t1 = frame / fps, (frame + 1) / fps
         n_steps = max(1, int(round((t1 - t0) / params.step)))
         tau = (t1 - t0) / n_steps
@@ -472,14 +710,14 @@ class PendulumCache:
         for k, j in enumerate(ch.joints):
             if j.is_dynamic:
                 continue
-            chn = doc.channels.get(angle_channel_id(asset_id, j.name))
+            chn = channels.get(angle_channel_id(asset_id, j.name))
             if chn is not None and chn.keys:
                 for d in range(3):
                     ang[d, :, k] = chn.evaluate(times, d)
         cx, cy = position_channel_ids(asset_id)
         tacc = np.zeros((n_steps, 2))
         for col, cid in enumerate((cx, cy)):
-            chn = doc.channels.get(cid)
+            chn = channels.get(cid)
             if chn is not None and chn.keys:
                 tacc[:, col] = chn.evaluate(times, 2)
         # Keyframed parts of the world angles, rates and accelerations for every sub-step.
@@ -503,30 +741,69 @@ class PendulumCache:
             else:
                 pa[sim.tops] = tacc[s]
             system.step(theta, omega, pa, tau)
-            self.steps_taken += 1
         # Keys on a dynamic joint's channel pose the pendulum at that frame.
         for kd in dyn_idx:
             k = int(kd)
-            chn = doc.channels.get(angle_channel_id(asset_id, ch.joints[k].name))
+            chn = channels.get(angle_channel_id(asset_id, ch.joints[k].name))
             if chn is None:
                 continue
             for key in chn.keys:
                 if abs(key.time * fps - (frame + 1)) < 0.5:
                     theta[k] = key.value
                     omega[k] = 0.0
-        return theta, omega
+        return theta, omega, n_steps
 
 
-_CACHES: weakref.WeakKeyDictionary[Document, PendulumCache] = weakref.WeakKeyDictionary()
+def _initial_angles(doc: Document, asset_id: str, ch: Character, t0: float) -> FloatArray:
+    """The simulation's start state: dynamic joints' keyed world angles at ``t0`` (else 0)."""
+    theta = np.zeros(len(ch.joints))
+    for k, j in enumerate(ch.joints):
+        if j.is_dynamic:
+            chn = doc.channels.get(angle_channel_id(asset_id, j.name))
+            if chn is not None and chn.keys:
+                theta[k] = float(chn.evaluate(t0))
+    return theta
+
+
+PENDULUM_CACHE = "pendulums"
 
 
 def simulation(doc: Document) -> PendulumCache:
-    """The document's pendulum cache (created on first use)."""
-    cache = _CACHES.get(doc)
-    if cache is None:
+    """The document's pendulum cache, ``doc.caches["pendulums"]`` (created on first use)."""
+    cache = doc.caches.get(PENDULUM_CACHE)
+    if not isinstance(cache, PendulumCache):
         cache = PendulumCache(doc)
-        _CACHES[doc] = cache
+        doc.caches[PENDULUM_CACHE] = cache
     return cache
+
+
+def simulation_ready(doc: Document, times: float | Iterable[float]) -> bool:
+    """True when every 2D character's pendulums are simulated at ``times`` (so views that
+    read the latest state show the exact one). Cheap; steps nothing."""
+    cache = doc.caches.get(PENDULUM_CACHE)
+    ts = [float(times)] if isinstance(times, (int, float)) else [float(t) for t in times]
+    for aid in character_assets(doc):
+        ch = doc.runtime.get(aid)
+        if not isinstance(ch, Character) or not ch.dynamic.any():
+            continue
+        if not isinstance(cache, PendulumCache) or not all(cache.ready(aid, t) for t in ts):
+            return False
+    return True
+
+
+def simulated_frames(doc: Document) -> tuple[int, int] | None:
+    """The frames ``(first, last)`` simulated for every 2D character with pendulums (last
+    < first when none is yet); None when no character has pendulums."""
+    cache = doc.caches.get(PENDULUM_CACHE)
+    first = doc.frame_range[0]
+    counts = []
+    for aid in character_assets(doc):
+        ch = doc.runtime.get(aid)
+        if isinstance(ch, Character) and ch.dynamic.any():
+            counts.append(cache.cached_frames(aid) if isinstance(cache, PendulumCache) else 0)
+    if not counts:
+        return None
+    return first, first + min(counts) - 1
 
 
 def channel_for(doc: Document, asset_id: str, joint_index: int) -> Channel | None:

@@ -11,18 +11,26 @@ because it compares them with the ones it was built from on every call.
 When the simulation blows up, :func:`cloth_state` keeps returning the last good frame and
 :func:`cloth_problem` returns the :class:`~qtanimator.core.cloth.ClothBlowUp` whose message
 says which parameter to change.
+
+Threads: a :class:`ClothCache` may be filled by a worker thread
+(:mod:`qtanimator.document.cloth_worker`) while the UI thread reads it. Stepping is
+serialised by the cache's lock, one frame at a time; :meth:`ClothCache.latest` never waits
+(it returns the newest frame already there), :meth:`ClothCache.positions` steps (or waits
+for the worker's current frame) until the frame asked for exists, as headless rendering
+and export need.
 """
 
 from __future__ import annotations
 
 import copy
 import math
-from collections.abc import Hashable
+import threading
+from collections.abc import Callable, Hashable
 from typing import Any
 
 import numpy as np
 
-from qtanimator.core.cloth import Cloth, ClothBlowUp, ClothParams, FloatArray
+from qtanimator.core.cloth import Cloth, ClothBlowUp, ClothParams, ClothStepCancelled, FloatArray
 from qtanimator.document.commands import AddAsset, Command, SetAssetProperty
 from qtanimator.document.document import Asset, Document
 from qtanimator.formats.errors import FormatError
@@ -31,7 +39,8 @@ ASSET_KIND = "cloth"
 
 
 class ClothCache:
-    """The runtime object of a cloth asset: a live :class:`Cloth` and per-frame positions."""
+    """The runtime object of a cloth asset: a :class:`Cloth` and the positions of every
+    frame simulated so far (read-only arrays; frame ``frame_start`` is the rest state)."""
 
     def __init__(self, properties: dict[str, Any], fps: float = 60.0, frame_start: int = 0) -> None:
         self.properties = copy.deepcopy(properties)
@@ -41,6 +50,7 @@ class ClothCache:
         self.cloth = Cloth(self.params)
         self.frames: list[FloatArray] = [self._freeze(self.cloth.positions)]
         self.error: ClothBlowUp | None = None
+        self._lock = threading.Lock()
 
     @staticmethod
     def _freeze(a: FloatArray) -> FloatArray:
@@ -55,20 +65,53 @@ class ClothCache:
     def triangles(self) -> Any:
         return self.cloth.triangles
 
-    def positions(self, frame: float) -> FloatArray:
-        """Positions at ``frame`` (read-only array), simulating forward as needed."""
+    def index_of(self, frame: float) -> int:
+        """The cache slot of ``frame``: whole frames from ``frame_start`` (rounded down, ≥ 0)."""
         if not math.isfinite(frame):
             raise ValueError("frame must be finite")
-        k = max(0, math.floor(frame + 1e-9) - self.frame_start)
-        dt = 1.0 / self.fps
-        while len(self.frames) <= k and self.error is None:
+        return max(0, math.floor(frame + 1e-9) - self.frame_start)
+
+    def step_frame(self, should_stop: Callable[[], bool] | None = None) -> bool:
+        """Simulate the next frame and cache it. False when nothing was added: the
+        simulation has blown up (see :attr:`error`) or ``should_stop`` cancelled the step
+        (the cloth is then as it was, so the next call computes the same frame)."""
+        with self._lock:
+            if self.error is not None:
+                return False
             try:
-                self.cloth.step(dt)
+                self.cloth.step(1.0 / self.fps, should_stop)
+            except ClothStepCancelled:
+                return False
             except ClothBlowUp as exc:
                 self.error = exc
-                break
+                return False
             self.frames.append(self._freeze(self.cloth.positions))
+            return True
+
+    def fill(self, count: int, should_stop: Callable[[], bool] | None = None) -> bool:
+        """Simulate until ``count`` frames are cached; False if stopped or blown up first."""
+        while len(self.frames) < count:
+            if should_stop is not None and should_stop():
+                return False
+            if not self.step_frame(should_stop):
+                return False
+        return True
+
+    def positions(self, frame: float) -> FloatArray:
+        """Positions at ``frame`` (read-only array), simulating forward as needed."""
+        k = self.index_of(frame)
+        self.fill(k + 1)
         return self.frames[min(k, len(self.frames) - 1)]
+
+    def latest(self, frame: float) -> tuple[FloatArray, bool]:
+        """Positions at ``frame`` if cached, else the newest cached frame; never waits.
+
+        Returns ``(positions, exact)``; ``exact`` is False when an earlier frame stands in.
+        """
+        k = self.index_of(frame)
+        frames = self.frames
+        n = len(frames)
+        return frames[min(k, n - 1)], k < n
 
     @property
     def cached_frames(self) -> int:

@@ -141,6 +141,10 @@ class Document:
         #: View state such as the 3D camera: saved with the project, never an edit (no
         #: command, no undo step, not part of :meth:`state`). See :meth:`set_view_state`.
         self.view_state: dict[str, Any] = {}
+        #: Derived data that belongs to this document and dies with it: the simulation
+        #: caches (``"pendulums"``: :func:`qtanimator.document.character2d.simulation`).
+        #: Never saved, never an edit; the caches invalidate themselves on changes.
+        self.caches: dict[str, Any] = {}
         self.path: str | None = None
         self._listeners: list[Listener] = []
         self._pending: _PendingChange | None = None

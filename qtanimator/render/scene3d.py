@@ -26,13 +26,16 @@ CLOTH_KIND = cloth.ASSET_KIND
 
 def scene_items(doc: Any, time: float, selection: tuple[str, str] = ("", ""),
                 cloth_override: dict[str, Any] | None = None,
-                errors: list[str] | None = None) -> list[SceneItem]:
+                errors: list[str] | None = None, wait: bool = True) -> list[SceneItem]:
     """Draw items for every 3D asset of ``doc`` at ``time`` seconds.
 
-    ``cloth_override`` maps a cloth asset id to a live ``Cloth`` simulation to show instead
-    of the document's cached state (the viewport's interactive cloth). With an ``errors``
-    list, an asset that cannot be evaluated is left out and its error appended there
-    (the viewport keeps drawing the rest); without it the error propagates.
+    ``cloth_override`` maps a cloth asset id to a live simulation (anything with
+    ``positions``, ``normals()``, ``triangles``, ``params`` and ``pinned``: a ``Cloth`` or a
+    ``LiveClothFrame``) to show instead of the document's cached state (the viewport's
+    interactive cloth). With an ``errors`` list, an asset that cannot be evaluated is left
+    out and its error appended there (the viewport keeps drawing the rest); without it the
+    error propagates. ``wait=False`` never simulates: a cloth whose frame is not cached yet
+    (a worker is filling the cache) shows its newest cached frame and is marked ``stale``.
     """
     items: list[SceneItem] = []
     for asset_id, asset in doc.assets.items():
@@ -43,7 +46,7 @@ def scene_items(doc: Any, time: float, selection: tuple[str, str] = ("", ""),
                     items.append(item)
             elif asset.kind == CLOTH_KIND:
                 live = (cloth_override or {}).get(asset_id)
-                citem = cloth_item(doc, asset_id, time, live)
+                citem = cloth_item(doc, asset_id, time, live, wait)
                 if citem is not None:
                     items.append(citem)
         except Exception as exc:
@@ -134,19 +137,26 @@ def gpu_skin_arrays(skin: Any) -> dict[str, Any]:
     return out
 
 
-def cloth_item(doc: Any, asset_id: str, time: float, live: Any = None) -> ClothDraw | None:
+def cloth_item(doc: Any, asset_id: str, time: float, live: Any = None, wait: bool = True) -> ClothDraw | None:
     """A cloth asset: the live simulation ``live`` when given, else the document's cached
-    simulation at the frame of ``time``."""
+    simulation at the frame of ``time`` (with ``wait=False`` the newest cached frame up to
+    it, never simulating: the item is ``stale`` when that is an earlier frame)."""
+    stale = False
     if live is not None:
         positions = np.asarray(live.positions, dtype=float)
         normals = np.asarray(live.normals(), dtype=float)
         triangles, params, pinned = live.triangles, live.params, live.pinned
     else:
         cache = cloth.cloth_cache(doc, asset_id)
-        positions = np.asarray(cache.positions(doc.time_to_frame(time)), dtype=float)
+        frame = doc.time_to_frame(time)
+        if wait:
+            positions = np.asarray(cache.positions(frame), dtype=float)
+        else:
+            cached, exact = cache.latest(frame)
+            positions, stale = np.asarray(cached, dtype=float), not exact
         triangles, params, pinned = cache.triangles, cache.params, cache.cloth.pinned
         normals = vertex_normals(positions, np.asarray(triangles, dtype=np.int64))
-    item = ClothDraw(asset_id, positions, normals, np.asarray(triangles, dtype=np.int64))
+    item = ClothDraw(asset_id, positions, normals, np.asarray(triangles, dtype=np.int64), stale=stale)
     for s in getattr(params, "spheres", None) or []:
         item.spheres.append((np.asarray(s[0], dtype=float), float(s[1])))
     if pinned is not None:

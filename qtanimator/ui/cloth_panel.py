@@ -1,7 +1,11 @@
 """The cloth dock (``clothDock``): every :class:`~qtanimator.core.cloth.ClothParams` field of
 the selected cloth asset, edited live through ``set_cloth_param_command`` (a drag on a field
 is one undo step), plus the interactive simulation controls of the 3D viewport (live
-simulation on / off, pause, reset; W/A/S/D/Q/E and Z/C in the viewport move the pins)."""
+simulation on / off, pause, reset; W/A/S/D/Q/E and Z/C in the viewport move the pins).
+
+The cloth is simulated on a background thread (the 3D viewport's ``cloth_worker``). When that
+takes longer than a second, ``clothProgress`` says how far it is and ``clothCancel`` stops it
+(then resumes it); a blow-up's explanation is shown there too."""
 
 from __future__ import annotations
 
@@ -104,6 +108,19 @@ class ClothPanel(QWidget):
         self.message.setObjectName("clothMessage")
         self.message.setWordWrap(True)
         outer.addWidget(self.message)
+        busy = QHBoxLayout()
+        self.progress = QLabel(self)
+        self.progress.setObjectName("clothProgress")
+        self.progress.setWordWrap(True)
+        self.cancel = QPushButton("Cancel", self)
+        self.cancel.setObjectName("clothCancel")
+        self.cancel.setToolTip("Stop simulating the cloth cache (the frames computed so far stay)")
+        self.cancel.clicked.connect(self._on_cancel)
+        busy.addWidget(self.progress, 1)
+        busy.addWidget(self.cancel)
+        outer.addLayout(busy)
+        self.progress.hide()
+        self.cancel.hide()
 
         body = QWidget(self)
         form_layout = QVBoxLayout(body)
@@ -128,6 +145,7 @@ class ClothPanel(QWidget):
         vp = self._viewport()
         if vp is not None:
             vp.liveClothChanged.connect(self._show_live)
+            vp.clothProgressChanged.connect(self.show_progress)
         self.refresh_assets()
 
     def _show_live(self, on: bool) -> None:
@@ -343,6 +361,41 @@ class ClothPanel(QWidget):
         for w in self.findChildren(QWidget):
             if w.objectName().startswith("cloth_"):
                 w.setEnabled(enabled)
+
+    # ------------------------------------------------- background simulation
+    #: Work shorter than this (seconds) shows no progress.
+    PROGRESS_AFTER_S = 1.0
+
+    def show_progress(self, progress: list[Any]) -> None:
+        """Show how far the cloth cache worker is (a list of ClothProgress)."""
+        lines: list[str] = []
+        running = cancelled = False
+        for p in progress:
+            if p.error:
+                lines.append(f"{p.asset_id}: {p.error}")
+            elif p.running and p.elapsed >= self.PROGRESS_AFTER_S:
+                running = True
+                lines.append(f"Simulating {p.asset_id}: {p.done} of {p.wanted} frames "
+                             f"({p.fraction:.0%}, {p.elapsed:.0f} s)")
+            elif p.cancelled:
+                cancelled = True
+                lines.append(f"{p.asset_id}: simulation stopped after {p.done} of {p.wanted} frames")
+        self.progress.setText("\n".join(lines))
+        self.progress.setVisible(bool(lines))
+        self.cancel.setText("Cancel" if running else "Resume")
+        self.cancel.setVisible(running or cancelled)
+
+    def _on_cancel(self) -> None:
+        vp = self._viewport()
+        worker = getattr(vp, "cloth_worker", None)
+        if worker is None:
+            return
+        if self.cancel.text() == "Cancel":
+            worker.cancel()
+        else:
+            worker.resume()
+            vp.watch_simulations()
+        self.show_progress(worker.progress())
 
     # --------------------------------------------------- live simulation
     def _viewport(self) -> Any:

@@ -13,12 +13,14 @@ view refreshes at most once per frame, from one change that names everything tha
 
 from __future__ import annotations
 
-from PySide6.QtCore import QElapsedTimer, QObject, QTimer, Signal
+from PySide6.QtCore import QElapsedTimer, QEvent, QObject, QTimer, Signal
 from PySide6.QtGui import QUndoStack
 
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, DocumentChange
 from qtanimator.document.gesture import Gesture
+from qtanimator.document.simulation import ensure_caches, stop_simulations
+from qtanimator.document.simulation import progress as simulation_progress
 from qtanimator.ui.undo import push_command, record_command
 
 #: The frame clock's period: views refresh at most once per 60 Hz frame during a gesture.
@@ -38,6 +40,9 @@ class EditorContext(QObject):
     documentReset = Signal()
     #: Playback started (True) or stopped (False).
     playingChanged = Signal(bool)
+    #: The background simulation added or dropped frames (at most once per frame clock
+    #: tick, only while someone watches it: :meth:`watch_simulation`).
+    simulationProgressed = Signal()
 
     def __init__(self, doc: Document | None = None, parent: QObject | None = None) -> None:
         super().__init__(parent)
@@ -56,7 +61,17 @@ class EditorContext(QObject):
         self._frame_clock.timeout.connect(self.flush_changes)
         #: How many times ``documentChanged`` was emitted (tests count refreshes with it).
         self.notifications = 0
+        ensure_caches(self.doc)  # caches drop invalid frames before views hear of a change
         self.doc.subscribe(self._on_document_event)
+        # Simulation polling: the worker thread cannot touch Qt, so the UI thread compares
+        # its revision once per frame while it works (see watch_simulation).
+        self._simulation_revision = -1
+        self._simulation_poll = QTimer(self)
+        self._simulation_poll.setObjectName("simulationPoll")
+        self._simulation_poll.setInterval(FRAME_INTERVAL_MS)
+        self._simulation_poll.timeout.connect(self._poll_simulation)
+        if parent is not None:
+            parent.installEventFilter(self)  # the window's close stops the worker threads
 
     # ---------------------------------------------------------------- document
     def _on_document_event(self, change: DocumentChange) -> None:
@@ -84,6 +99,27 @@ class EditorContext(QObject):
     def push(self, command: Command) -> None:
         """Do a command and put it on the undo stack (merging drags into one step)."""
         push_command(self.undo_stack, self.doc, command)
+
+    # -------------------------------------------------------------- simulation
+    def watch_simulation(self) -> None:
+        """Poll the background simulation once per frame until it is idle and emit
+        ``simulationProgressed`` when frames arrive. Views call it when they show a frame
+        that is not simulated yet."""
+        if not self._simulation_poll.isActive():
+            self._simulation_poll.start()
+
+    def _poll_simulation(self) -> None:
+        revision, busy = simulation_progress(self.doc)
+        if revision != self._simulation_revision:
+            self._simulation_revision = revision
+            self.simulationProgressed.emit()
+        elif not busy:
+            self._simulation_poll.stop()
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.Close and watched is self.parent():
+            stop_simulations(self.doc)  # they start again if the close is cancelled
+        return super().eventFilter(watched, event)
 
     # ---------------------------------------------------------------- gestures
     def begin_gesture(self, text: str) -> Gesture:

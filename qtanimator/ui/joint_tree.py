@@ -92,13 +92,13 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
     runtime = doc.runtime.get(asset)
     m2, m3 = c2d(), c3d()
     if m2 is not None and kind == m2.ASSET_KIND and runtime is not None:
-        pose = m2.evaluate_pose(doc, asset, time)
+        pose = m2.evaluate_pose(doc, asset, time, block=False)  # a view: never simulates
         if joint == "":
             tx, ty = (float(v) for v in pose.translation)
 
             def move(axis: int) -> Callable[[float, float, object], Command]:
                 def make(value: float, t: float, gesture: object) -> Command:
-                    cur = m2.evaluate_pose(doc, asset, t).translation
+                    cur = m2.translation(doc, asset, t)
                     xy = (value, float(cur[1])) if axis == 0 else (float(cur[0]), value)
                     return m2.move_character(doc, asset, xy, t, gesture=gesture)
                 return make
@@ -106,7 +106,7 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
             return [DofSpec("x", tx, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(0), ""),
                     DofSpec("y", ty, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(1), "")]
         index = runtime.joint_index(joint)
-        angle = float(np.asarray(m2.joint_angles(doc, asset, time))[index])
+        angle = float(np.asarray(m2.joint_angles(doc, asset, time, block=False))[index])
 
         def key(value: float, t: float, gesture: object) -> Command:
             return m2.key_joint(doc, asset, index, math.radians(value), t, gesture=gesture)

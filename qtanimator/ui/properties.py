@@ -242,7 +242,7 @@ class PropertiesPanel(QWidget):
         form.addRow("Pendulum length L", QLabel(f"{float(np.hypot(*(com - j.pivot))):.3f}"))
 
         def angle() -> str:
-            a = float(np.asarray(m2.joint_angles(doc, asset, self.ctx.time))[index])
+            a = float(np.asarray(m2.joint_angles(doc, asset, self.ctx.time, block=False))[index])
             return f"{math.degrees(a):.3f}°"
 
         self._label(form, "Angle (local)", angle, "jointAngle")

@@ -234,6 +234,11 @@ class RigEditorView(QGraphicsView):
         ctx.documentReset.connect(self._on_reset)
         ctx.selectionChanged.connect(lambda _a, _j: self.viewport().update())
         ctx.playingChanged.connect(self._on_playing)
+        # Pendulum frames come from a background worker: poses() reads the latest state and
+        # the view repaints when new frames arrive for a frame it shows (drawBackground).
+        self._poses_exact = True
+        self._simulation_pending = False
+        ctx.simulationProgressed.connect(lambda: self.viewport().update() if self._simulation_pending else None)
         self._sync_items()
 
     def _on_playing(self, playing: bool) -> None:
@@ -252,11 +257,14 @@ class RigEditorView(QGraphicsView):
             return []
 
     def poses(self) -> dict[str, Any]:
-        """The posed characters at the current frame (computed once per change)."""
+        """The posed characters at the current frame (computed once per change). Pendulums
+        show the latest simulated state and are never simulated here: until the background
+        worker reaches the frame, the poses are read again at each repaint."""
         if self._poses is None:
             c2d = _c2d()
-            t = self.ctx.time
-            self._poses = {aid: c2d.evaluate_pose(self.ctx.doc, aid, t) for aid in self.character_ids()}
+            doc, t = self.ctx.doc, self.ctx.time
+            self._poses_exact = c2d.simulation_ready(doc, t)  # checked first: the worker only adds
+            self._poses = {aid: c2d.evaluate_pose(doc, aid, t, block=False) for aid in self.character_ids()}
         return self._poses
 
     def selected_joint_index(self, asset: str) -> int | None:
@@ -551,18 +559,26 @@ class RigEditorView(QGraphicsView):
     # ---------------------------------------------------------------- drawing
     def drawBackground(self, painter: QPainter, rect: QRectF) -> None:
         painter.fillRect(rect, BACKGROUND)
-        ghosts = ri.onion_frames(self.ctx.frame, self.onion, *self.ctx.doc.frame_range)
-        if not ghosts:
+        doc = self.ctx.doc
+        ghosts = ri.onion_frames(self.ctx.frame, self.onion, *doc.frame_range)
+        ids = self.character_ids()
+        if not ids:
+            self._simulation_pending = False
             return
         c2d, p2d = _c2d(), _painter2d()
-        doc = self.ctx.doc
+        if not self._poses_exact:
+            self._poses = None  # read before the worker caught up: read the latest again
+        times = [self.ctx.time] + [doc.frame_to_time(frame) for frame, _side, _opacity in ghosts]
+        self._simulation_pending = not c2d.simulation_ready(doc, times)
+        if self._simulation_pending:
+            self.ctx.watch_simulation()
         for frame, side, opacity in ghosts:
             r, g, b = self.onion.before_tint if side == "before" else self.onion.after_tint
             tint = QColor(r, g, b, 170)
             t = doc.frame_to_time(frame)
-            for aid in self.character_ids():
-                p2d.draw_character(painter, doc.runtime[aid], c2d.evaluate_pose(doc, aid, t), tint=tint,
-                                   opacity=opacity)
+            for aid in ids:
+                p2d.draw_character(painter, doc.runtime[aid], c2d.evaluate_pose(doc, aid, t, block=False),
+                                   tint=tint, opacity=opacity)
 
     def drawForeground(self, painter: QPainter, rect: QRectF) -> None:
         self.frames_drawn += 1

@@ -39,10 +39,11 @@ def character_ids(doc: Document) -> list[str]:
 
 def pick(doc: Document, time: float, point: Sequence[float],
          tolerance: float = PICK_TOLERANCE) -> tuple[str, int] | None:
-    """The topmost (character, joint index) under ``point``, or None."""
+    """The topmost (character, joint index) under ``point``, or None. Picks what the editor
+    shows: pendulums at their latest simulated state (nothing is simulated here)."""
     for aid in reversed(character_ids(doc)):
         character = doc.runtime[aid]
-        pose = c2d.evaluate_pose(doc, aid, time)
+        pose = c2d.evaluate_pose(doc, aid, time, block=False)
         j = character.hit_test(pose, np.asarray(point, dtype=np.float64), tolerance)
         if j is not None:
             return aid, int(j)
@@ -61,10 +62,11 @@ def rotation_delta(pivot: Sequence[float], press: Sequence[float], cursor: Seque
 
 # ------------------------------------------------------------------------ drags
 def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> Drag:
-    """Left-drag on a joint: rotate it about its pivot following the cursor."""
-    pose = c2d.evaluate_pose(doc, asset, time)
+    """Left-drag on a joint: rotate it about its pivot following the cursor (from the pose
+    the editor shows)."""
+    pose = c2d.evaluate_pose(doc, asset, time, block=False)
     pivot = pose.pivots[joint].copy()
-    start = float(np.asarray(c2d.joint_angles(doc, asset, time))[joint])
+    start = float(np.asarray(c2d.joint_angles(doc, asset, time, block=False))[joint])
     cursor = yield None
     while True:
         angle = start + rotation_delta(pivot, press, cursor)
@@ -73,7 +75,7 @@ def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], t
 
 def move_drag(doc: Document, asset: str, press: Sequence[float], time: float) -> Drag:
     """Left-drag on a root joint: move the character (a position key at ``time``)."""
-    start = np.asarray(c2d.evaluate_pose(doc, asset, time).translation, dtype=np.float64).copy()
+    start = np.asarray(c2d.translation(doc, asset, time), dtype=np.float64).copy()
     p0 = np.asarray(press, dtype=np.float64)
     cursor = yield None
     while True:
@@ -84,7 +86,7 @@ def move_drag(doc: Document, asset: str, press: Sequence[float], time: float) ->
 def ik_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> Drag:
     """Right-drag: pull the picked point of ``joint`` towards the cursor with the IK solver
     (the document's IK settings; see ``character2d.ik_drag``)."""
-    pose = c2d.evaluate_pose(doc, asset, time)
+    pose = c2d.evaluate_pose(doc, asset, time, block=False)
     local = pose.to_local(joint, np.asarray(press, dtype=np.float64))
     cursor = yield None
     while True:
@@ -94,7 +96,7 @@ def ik_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time:
 
 def ik_source(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> FloatArray:
     """The rest-pose point of ``joint`` under ``press`` (kept for the debug dot)."""
-    pose = c2d.evaluate_pose(doc, asset, time)
+    pose = c2d.evaluate_pose(doc, asset, time, block=False)
     return np.asarray(pose.to_local(joint, np.asarray(press, dtype=np.float64)), dtype=np.float64)
 
 
@@ -163,7 +165,8 @@ def path_keys(doc: Document, asset: str) -> list[PathKey]:
 
 def hud_lines(doc: Document, asset: str, joint: int | None, time: float) -> list[str]:
     """The HUD text: the character's position / velocity / acceleration and the joint's
-    type with its angle (keyframed) or θ and ω (dynamic)."""
+    type with its angle (keyframed) or θ and ω (dynamic: the latest simulated state, never
+    simulated here; a line says which frame it is from until the worker catches up)."""
     character = doc.runtime[asset]
     cx, cy = _xy_channels(doc, asset)
     pos = (float(_eval(cx, time)), float(_eval(cy, time)))
@@ -179,13 +182,15 @@ def hud_lines(doc: Document, asset: str, joint: int | None, time: float) -> list
     lines.append(f"JOINT  {j.name}")
     if j.is_dynamic:
         frame = int(round(doc.time_to_frame(time)))
-        theta_all, omega_all = c2d.simulation(doc).state(asset, frame)
+        theta_all, omega_all, shown = c2d.simulation(doc).latest_state(asset, frame)
         theta, omega = float(theta_all[joint]), float(omega_all[joint])
         lines += ["type          dynamic (pendulum)",
                   f"θ             {math.degrees(theta):8.2f}°",
                   f"ω             {math.degrees(omega):8.2f}°/s"]
+        if shown < frame:
+            lines.append(f"simulating…   (frame {shown} shown)")
     else:
-        angle = float(np.asarray(c2d.joint_angles(doc, asset, time))[joint])
+        angle = float(np.asarray(c2d.joint_angles(doc, asset, time, block=False))[joint])
         lines += ["type          keyframed", f"angle         {math.degrees(angle):8.2f}°"]
     return lines
 

@@ -1,4 +1,5 @@
-"""The timeline: frame ruler, key ticks, the current-frame cursor, and the play controls.
+"""The timeline: frame ruler, key ticks, the current-frame cursor, the simulation cache
+bar, and the play controls.
 
 Keys follow the reference animator: Space play / pause, ←/→ step (wrapping), Shift+←/→
 ±10 frames, Alt+←/→ previous / next key, Home or ↑ start, End or ↓ end, ``[`` / ``]``
@@ -12,7 +13,17 @@ import math
 from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QPointF, QRectF, QSize, Qt
-from PySide6.QtGui import QAction, QColor, QFont, QKeySequence, QMouseEvent, QPainter, QPaintEvent, QPen
+from PySide6.QtGui import (
+    QAction,
+    QColor,
+    QFont,
+    QKeySequence,
+    QMouseEvent,
+    QPainter,
+    QPaintEvent,
+    QPen,
+    QResizeEvent,
+)
 from PySide6.QtWidgets import (
     QHBoxLayout,
     QLabel,
@@ -31,10 +42,15 @@ from qtanimator.ui.playback import Playback, playback_frame
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
 
-__all__ = ["Playback", "TimelineWidget", "TimelinePanel", "install", "key_frames", "playback_frame"]
+__all__ = ["CacheBar", "Playback", "TimelineWidget", "TimelinePanel", "install", "key_frames",
+           "playback_frame"]
 
 RANGE_STEP = 100
 MARGIN = 10
+#: The cache bar: a strip this high in the timeline's bottom margin, under the ruler.
+CACHE_BAR_HEIGHT = 4
+#: Simulated frames (Blender draws its simulation caches as a coloured band too).
+CACHE_COLOR = QColor(80, 170, 255)
 
 
 def key_frames(ctx: EditorContext, asset: str | None = None) -> list[float]:
@@ -67,9 +83,19 @@ class TimelineWidget(QWidget):
         ctx.documentChanged.connect(self._on_document_changed)
         ctx.documentReset.connect(self._invalidate)
         ctx.selectionChanged.connect(lambda _a, _j: self._invalidate())
+        self.cache_bar = CacheBar(self)
+        self._place_cache_bar()
 
     def sizeHint(self) -> QSize:
         return QSize(800, 52)
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        super().resizeEvent(event)
+        self._place_cache_bar()
+
+    def _place_cache_bar(self) -> None:
+        # In the bottom margin, right under the ruler (drawn down to height − 6).
+        self.cache_bar.setGeometry(0, self.height() - 5, self.width(), CACHE_BAR_HEIGHT)
 
     # --------------------------------------------------------------- keys
     def _on_document_changed(self, change: DocumentChange) -> None:
@@ -171,6 +197,70 @@ class TimelineWidget(QWidget):
         x = self.frame_to_x(self.ctx.frame)
         p.setPen(QPen(QColor(230, 0, 0), 2))
         p.drawLine(QPointF(x, bar.top() - 2), QPointF(x, bar.bottom()))
+        p.end()
+
+
+class CacheBar(QWidget):
+    """The simulation cache bar: a thin strip under the frame ruler whose coloured band
+    spans the frames the pendulums are simulated for (every 2D character with pendulums).
+
+    It follows the background worker through ``ctx.simulationProgressed`` (at most once per
+    frame) and document changes; :meth:`simulated` is the range it draws, also given as its
+    tool tip and accessible description. It lets mouse presses through to the ruler.
+    """
+
+    def __init__(self, timeline: TimelineWidget) -> None:
+        super().__init__(timeline)
+        self.setObjectName("cacheBar")
+        self.setAccessibleName("Simulation cache")
+        self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents, True)
+        self.timeline = timeline
+        self.ctx = timeline.ctx
+        self._range: tuple[int, int] | None = None
+        #: How many times the band was recomputed (tests: at most once per progress signal).
+        self.refreshes = 0
+        self.ctx.simulationProgressed.connect(self.refresh)
+        self.ctx.documentChanged.connect(lambda _change: self.refresh())
+        self.ctx.documentReset.connect(self.refresh)
+        self.refresh()
+
+    def simulated(self) -> tuple[int, int] | None:
+        """``(first, last)`` simulated frames (last < first: none yet); None when no 2D
+        character has pendulums."""
+        return self._range
+
+    def refresh(self) -> None:
+        from qtanimator.document import character2d as c2d
+        from qtanimator.document.simulation import progress
+
+        self.refreshes += 1
+        doc = self.ctx.doc
+        simulated = c2d.simulated_frames(doc)
+        if progress(doc)[1]:
+            self.ctx.watch_simulation()  # follow the worker while it runs
+        if simulated != self._range:
+            self._range = simulated
+            if simulated is None:
+                text = "No simulation"
+            elif simulated[1] < simulated[0]:
+                text = "Simulation: no frame simulated yet"
+            else:
+                text = f"Simulated frames {simulated[0]}–{simulated[1]}"
+            self.setToolTip(text)
+            self.setAccessibleDescription(text)
+            self.update()
+
+    def paintEvent(self, _event: QPaintEvent) -> None:
+        p = QPainter(self)
+        first, last = self.timeline._span()
+        x0, x1 = self.timeline.frame_to_x(first), self.timeline.frame_to_x(last)
+        h = self.height()
+        p.fillRect(QRectF(x0, 0, x1 - x0, h), QColor(70, 70, 76))
+        if self._range is not None and self._range[1] >= self._range[0]:
+            a = self.timeline.frame_to_x(max(self._range[0], first))
+            b = self.timeline.frame_to_x(min(self._range[1], last))
+            if b >= a:
+                p.fillRect(QRectF(a, 0, max(b - a, 1.0), h), CACHE_COLOR)
         p.end()
 
 

@@ -1,27 +1,34 @@
 """The 3D viewport: skinned characters, skeletons and cloth under two coloured lights.
 
-``install(window)`` adds a central tab "3D" holding a toolbar, the GL view (a
-QOpenGLWidget named ``viewport3d``) and clip playback controls.
+``install(window)`` adds a central tab "3D" holding a toolbar, the GL view (``viewport3d``:
+a widget holding a QOpenGLWindow in a window container, or a QOpenGLWidget, see
+:data:`DEFAULT_SURFACE`) and clip playback controls.
 
 Mouse: left click picks a joint (``ctx.select``); left drag orbits (on a live cloth it grabs
 the cloth, on a light's sphere it moves the light); middle drag or Shift+left pans; wheel or
 Ctrl+left zooms; right drag on a joint solves IK on its chain (one undo step, keyed at the
 current frame); right drag elsewhere zooms. Keys: F frames the selection (or everything),
 W/A/S/D/Q/E move a live cloth's pins, Z/C rotate them, P pauses the live cloth, R resets it,
-Escape cancels an IK drag.
+Escape cancels an IK or light drag.
+
+Cloth never runs on the UI thread: a :class:`~qtanimator.document.cloth_worker.ClothWorker`
+fills the document's cloth caches in the background (the view draws the newest frame there
+and never waits), and the interactive cloth is a
+:class:`~qtanimator.document.cloth_worker.LiveCloths` stepping in real time on its own thread.
+A timer polls both and repaints when something new is there.
 """
 
 from __future__ import annotations
 
 import dataclasses
-import itertools
 import math
 import time as _time
 from typing import Any
 
 import numpy as np
 from PySide6.QtCore import QElapsedTimer, QPointF, Qt, QTimer, Signal
-from PySide6.QtGui import QKeyEvent, QMouseEvent, QWheelEvent
+from PySide6.QtGui import QImage, QKeyEvent, QMouseEvent, QPixmap, QSurfaceFormat, QWheelEvent
+from PySide6.QtOpenGL import QOpenGLWindow
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
 from PySide6.QtWidgets import (
     QCheckBox,
@@ -37,6 +44,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from qtanimator.document.cloth_worker import LiveCloths, cloth_worker
 from qtanimator.document.document import DocumentChange
 from qtanimator.render.gl import surface_format
 from qtanimator.render.gl.camera import OrbitCamera
@@ -52,10 +60,8 @@ from qtanimator.render.gl.renderer import (
     ViewOptions,
     grid_scale_for,
 )
-from qtanimator.render.scene3d import CLOTH_KIND, scene_bounds, scene_items
+from qtanimator.render.scene3d import scene_bounds, scene_items
 from qtanimator.ui.context import EditorContext
-
-_gestures = itertools.count(1)
 
 #: Cloth pin moves per key press: metres and radians.
 PIN_STEP = 0.05
@@ -69,82 +75,73 @@ PIN_TURNS = {Qt.Key.Key_Z: PIN_TURN, Qt.Key.Key_C: -PIN_TURN}
 #: The live cloth's fixed simulation step (seconds).
 SIM_DT = 1.0 / 60.0
 
+#: How the GL picture reaches the screen: "window" (a QOpenGLWindow in a window container:
+#: the window system shows it, the main window is not composed through OpenGL) or "widget"
+#: (a QOpenGLWidget: Qt composes the whole main window with OpenGL every frame). See
+#: docs/decisions.md; the environment variable ``QTANIMATOR_VIEW3D_SURFACE`` overrides it.
+DEFAULT_SURFACE = "window"
+
+
+def surface_kind() -> str:
+    """The GL surface kind to use ("window" or "widget")."""
+    import os
+
+    kind = os.environ.get("QTANIMATOR_VIEW3D_SURFACE", DEFAULT_SURFACE).strip().lower()
+    return kind if kind in ("window", "widget") else DEFAULT_SURFACE
+
+
+class _GLWidgetSurface(QOpenGLWidget):
+    """The GL surface as a QOpenGLWidget child of the view (input goes to the view)."""
+
+    def __init__(self, view: Viewport3D) -> None:
+        super().__init__(view)
+        self.view = view
+        self.setFormat(surface_format())
+        self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents, True)
+        self.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+
+    def initializeGL(self) -> None:
+        self.view.initialize_gl()
+
+    def paintGL(self) -> None:
+        self.view.paint_gl()
+
+
+class _GLWindowSurface(QOpenGLWindow):
+    """The GL surface as a QOpenGLWindow shown in a window container: the window system
+    shows its pixels, so the main window is not composed through OpenGL. Input that the
+    native window receives is handed to the view."""
+
+    def __init__(self, view: Viewport3D) -> None:
+        super().__init__(QOpenGLWindow.UpdateBehavior.NoPartialUpdate)
+        self.view = view
+        self.setFormat(surface_format())
+
+    def initializeGL(self) -> None:
+        self.view.initialize_gl()
+
+    def paintGL(self) -> None:
+        self.view.paint_gl()
+
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        self.view.setFocus(Qt.FocusReason.MouseFocusReason)
+        self.view.mousePressEvent(event)
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        self.view.mouseMoveEvent(event)
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        self.view.mouseReleaseEvent(event)
+
+    def wheelEvent(self, event: QWheelEvent) -> None:
+        self.view.wheelEvent(event)
+
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        self.view.keyPressEvent(event)
+
 
 #: The document parameter holding the 3D camera (view state, written when saving).
 CAMERA_PARAMETER = "view3d.camera"
-
-
-class LiveCloths:
-    """Interactive cloth simulations, one per cloth asset, stepped by the wall clock.
-
-    While ``enabled`` the viewport shows these instead of the document's cached simulation,
-    so pins can be moved with the keyboard and the cloth grabbed with the mouse.
-    """
-
-    def __init__(self) -> None:
-        self.enabled = False
-        self.paused = False
-        self.cloths: dict[str, Any] = {}
-        self.errors: dict[str, str] = {}
-
-    def sync(self, doc: Any) -> None:
-        """Create live cloths for new cloth assets, drop removed ones, follow parameter edits."""
-        ids = [a for a, asset in doc.assets.items() if asset.kind == CLOTH_KIND]
-        for key in [k for k in self.cloths if k not in ids]:
-            del self.cloths[key]
-        for asset_id in ids:
-            params = cloth_params(doc, asset_id)
-            if params is None:
-                continue
-            cloth = self.cloths.get(asset_id)
-            if cloth is None:
-                from qtanimator.core.cloth import Cloth
-
-                self.cloths[asset_id] = Cloth(params)
-            elif cloth.params != params:
-                cloth.set_params(params)
-
-    def step(self, dt: float) -> None:
-        if not self.enabled or self.paused:
-            return
-        for asset_id, cloth in self.cloths.items():
-            if cloth.error is not None:
-                continue
-            try:
-                cloth.step(dt)
-            except RuntimeError as exc:  # ClothBlowUp: the cloth stays stopped until reset
-                self.errors[asset_id] = str(exc)
-
-    def reset(self) -> None:
-        for cloth in self.cloths.values():
-            cloth.reset()
-        self.errors.clear()
-
-    def move_pins(self, translation: Any = (0.0, 0.0, 0.0), rotation: Any = None) -> None:
-        for cloth in self.cloths.values():
-            cloth.move_pins(translation, rotation)
-
-
-def cloth_params(doc: Any, asset_id: str) -> Any:
-    """The ClothParams of a cloth asset (from its properties), or None."""
-    try:
-        from qtanimator.core.cloth import ClothParams
-    except ImportError:
-        return None
-    try:
-        from qtanimator.document import cloth as cloth_doc
-
-        getter = getattr(cloth_doc, "cloth_params", None)
-        if getter is not None:
-            return getter(doc, asset_id)
-    except ImportError:
-        pass
-    props = doc.assets[asset_id].properties
-    data = props.get("params", props)
-    try:
-        return ClothParams.from_dict(data)
-    except (TypeError, ValueError):
-        return ClothParams()
 
 
 def ik_dofs(skeleton: Any, joint: int, chain_length: int) -> list[tuple[int, int]]:
@@ -158,30 +155,62 @@ def ik_dofs(skeleton: Any, joint: int, chain_length: int) -> list[tuple[int, int
     return dofs or chain_dofs(skeleton, joint, chain_length, include_root=True)
 
 
-class Viewport3D(QOpenGLWidget):
-    """The GL view of the 3D scene (object name ``viewport3d``)."""
+class Viewport3D(QWidget):
+    """The GL view of the 3D scene (object name ``viewport3d``): camera, picking, gestures
+    and live cloth; the pixels come from a GL surface filling it (``surface``: a
+    QOpenGLWindow in a window container by default, or a QOpenGLWidget, see
+    :data:`DEFAULT_SURFACE`). Mouse and key events reach this widget either way."""
 
     #: CPU milliseconds the last paintGL took (scene build + GL calls).
     frameRendered = Signal(float)
     #: The interactive cloth simulation was switched on or off.
     liveClothChanged = Signal(bool)
+    #: The cloth cache worker moved on: a list of ClothProgress (at most ~10 per second).
+    clothProgressChanged = Signal(object)
 
-    def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
+    #: How often the simulations are polled while they run (ms).
+    POLL_MS = 16
+    #: How often the progress is announced while the worker runs (ms).
+    PROGRESS_MS = 100
+
+    def __init__(self, ctx: EditorContext, parent: QWidget | None = None, surface: str | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("viewport3d")
-        self.setFormat(surface_format())
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMinimumSize(160, 120)
+        layout = QVBoxLayout(self)
+        layout.setContentsMargins(0, 0, 0, 0)
+        #: "window" or "widget": how the picture reaches the screen.
+        self.surface_kind = surface or surface_kind()
+        self.gl: _GLWindowSurface | _GLWidgetSurface
+        if self.surface_kind == "window":
+            self.gl = _GLWindowSurface(self)
+            container = QWidget.createWindowContainer(self.gl, self)
+            container.setObjectName("viewport3dSurface")
+            container.setFocusPolicy(Qt.FocusPolicy.NoFocus)
+            container.setMinimumSize(1, 1)
+            layout.addWidget(container)
+            self.surface_widget: QWidget = container
+        else:
+            self.gl = _GLWidgetSurface(self)
+            self.gl.setObjectName("viewport3dSurface")
+            layout.addWidget(self.gl)
+            self.surface_widget = self.gl
         self.ctx = ctx
         self.camera = OrbitCamera()
         self.options = ViewOptions()
         self.renderer = SceneRenderer()
-        self.live = LiveCloths()
+        #: The interactive cloths (stepped on their own thread while enabled).
+        self.live = LiveCloths(SIM_DT)
+        #: Fills the document's cloth caches on a background thread (``doc.caches["cloths"]``).
+        self.cloth_worker = cloth_worker(ctx.doc)
         self.ik_chain_length = 3
         self.last_error = ""
         self.last_frame_ms = 0.0
         self.gl_info = ""
+        self.cloth_stale = False    # the last paint showed an earlier cloth frame (still simulating)
         self._items: list[SceneItem] = []
+        self._offscreen: tuple[Any, SceneRenderer] | None = None   # render_image before the first show
         self._framed_once = False   # the camera frames the scene at the first paint with items
         self._grid_pending = False  # a restored camera: size the grid at the first paint
         self._drag: dict[str, Any] | None = None
@@ -190,74 +219,120 @@ class Viewport3D(QOpenGLWidget):
         ctx.selectionChanged.connect(lambda _a, _j: self.update())
         ctx.documentChanged.connect(self._on_document_changed)
         ctx.documentReset.connect(self._on_document_reset)
-        self._sim_acc = 0.0
-        self._sim_clock = QElapsedTimer()
+        self._seen_live = -1
+        self._seen_worker = -1
+        self._progress_clock = QElapsedTimer()
+        self._progress_clock.start()
+        self._was_busy = False
         self._sim_timer = QTimer(self)
-        self._sim_timer.setInterval(16)
-        self._sim_timer.timeout.connect(self._tick_cloth)
-        self.live.sync(ctx.doc)
+        self._sim_timer.setInterval(self.POLL_MS)
+        self._sim_timer.timeout.connect(self._poll_simulations)
+        self._sim_timer.start()
+        worker, live = self.cloth_worker, self.live
+        # The threads stop with the view (the cache worker starts again when asked).
+        self.destroyed.connect(lambda *_a: (worker.shutdown(1.0), live.close(1.0)))
         self.restore_camera()
 
     # ------------------------------------------------------------ document
     def _on_document_changed(self, change: DocumentChange) -> None:
-        if change.assets or change.parameters:
+        if self.live.enabled and (change.assets or change.parameters):
             self.live.sync(self.ctx.doc)
+        self.watch_simulations()
         self.update()
 
     def _on_document_reset(self) -> None:
-        self.live.cloths.clear()
-        self.live.sync(self.ctx.doc)
+        self.live.clear()
+        if self.live.enabled:
+            self.live.sync(self.ctx.doc)
+        self.watch_simulations()
         self.restore_camera()
         self.update()
 
     def set_live_cloth(self, enabled: bool) -> None:
         changed = enabled != self.live.enabled
         self.live.enabled = enabled
-        self.live.sync(self.ctx.doc)
         if enabled:
-            self._sim_clock.start()
-            self._sim_timer.start()
-        else:
-            self._sim_timer.stop()
+            self.live.sync(self.ctx.doc)
+        self.watch_simulations()
         if changed:
             self.liveClothChanged.emit(enabled)
         self.update()
 
-    def _tick_cloth(self) -> None:
-        """Step the live cloths at a fixed 60 Hz, independent of the timer's rate."""
-        self._sim_acc = min(self._sim_acc + self._sim_clock.restart() / 1000.0, 3 * SIM_DT)
-        stepped = False
-        while self._sim_acc >= SIM_DT:
-            self.live.step(SIM_DT)
-            self._sim_acc -= SIM_DT
-            stepped = True
-        if stepped:
+    def watch_simulations(self) -> None:
+        """Poll the cloth threads (until they have nothing new to show)."""
+        if not self._sim_timer.isActive():
+            self._sim_timer.start()
+
+    def _poll_simulations(self) -> None:
+        """Repaint when a simulation thread has something new; announce the progress."""
+        live, worker = self.live, self.cloth_worker
+        if live.enabled and live.version != self._seen_live:
+            self._seen_live = live.version
             self.update()
+        busy = worker.busy
+        if worker.version != self._seen_worker:
+            self._seen_worker = worker.version
+            if self.cloth_stale:
+                self.update()
+            if busy != self._was_busy or self._progress_clock.elapsed() >= self.PROGRESS_MS:
+                self._progress_clock.restart()
+                self.clothProgressChanged.emit(worker.progress())
+        elif busy != self._was_busy:
+            self.clothProgressChanged.emit(worker.progress())
+        self._was_busy = busy
+        if not busy and not live.enabled:
+            self._sim_timer.stop()
 
     # ----------------------------------------------------------------- GL
-    def initializeGL(self) -> None:
+    def update(self) -> None:  # type: ignore[override]
+        """Ask for a new picture (drawn at the next frame)."""
+        self.gl.update()
+
+    def format(self) -> QSurfaceFormat:
+        """The GL surface's format (OpenGL 3.3 core, depth, multisampling)."""
+        return self.gl.format()
+
+    def initialize_gl(self) -> None:
+        """The surface's initializeGL: its context is current."""
         from OpenGL import GL
 
         version = GL.glGetString(GL.GL_VERSION)
         renderer = GL.glGetString(GL.GL_RENDERER)
         self.gl_info = f"{version.decode() if version else '?'} / {renderer.decode() if renderer else '?'}"
         self.renderer.initialize()
-        self.context().aboutToBeDestroyed.connect(self._release_gl)
+        context = self.gl.context()
+        if context is not None:
+            context.aboutToBeDestroyed.connect(self._release_gl)
 
     def _release_gl(self) -> None:
-        self.makeCurrent()
+        try:
+            self.gl.makeCurrent()
+        except RuntimeError:
+            return  # the surface is being deleted: its context (not shared) takes the resources along
         self.renderer.release()
-        self.doneCurrent()
+        self.gl.doneCurrent()
 
     def build_items(self) -> list[SceneItem]:
-        """What to draw now (and pick against)."""
-        override = self.live.cloths if self.live.enabled else None
+        """What to draw now (and pick against). Never simulates: a cloth shows the newest
+        frame its cache has (the worker is asked for the one missing) or its live snapshot."""
+        override = self.live.frames() if self.live.enabled else None
         errors: list[str] = []   # an asset that fails is left out; the others still draw
-        items = scene_items(self.ctx.doc, self.ctx.time, self.ctx.selection, override, errors)
+        items = scene_items(self.ctx.doc, self.ctx.time, self.ctx.selection, override, errors, wait=False)
         self.last_error = "; ".join(errors)
+        stale = [i for i in items if isinstance(i, ClothDraw) and i.stale]
+        for item in stale:
+            self.cloth_worker.request(item.asset_id, self.ctx.frame)
+        self.cloth_stale = bool(stale)
+        if stale:
+            self.watch_simulations()
         return items
 
-    def paintGL(self) -> None:
+    def paint_gl(self) -> None:
+        """The surface's paintGL: build the scene and draw it."""
+        ratio = self.gl.devicePixelRatio()
+        self._draw(self.renderer, max(1, int(self.gl.width() * ratio)), max(1, int(self.gl.height() * ratio)))
+
+    def _draw(self, renderer: SceneRenderer, w: int, h: int) -> None:
         start = _time.perf_counter()
         self._items = self.build_items()
         if not self._framed_once and self._items:
@@ -268,21 +343,50 @@ class Viewport3D(QOpenGLWidget):
             if bounds is not None:
                 self.options.grid_scale = grid_scale_for(*bounds)
             self._grid_pending = False
-        ratio = self.devicePixelRatioF()
-        w, h = max(1, int(self.width() * ratio)), max(1, int(self.height() * ratio))
         doc = self.ctx.doc
         self.options.light_gizmo_size = self.gizmo_size()
-        self.renderer.render(self._items, self.camera, w, h, lights_of(doc), ambient_of(doc), self.options)
+        renderer.render(self._items, self.camera, w, h, lights_of(doc), ambient_of(doc), self.options)
         self.last_frame_ms = (_time.perf_counter() - start) * 1000.0
         self.frameRendered.emit(self.last_frame_ms)
 
     def render_image(self) -> np.ndarray:
-        """The current picture as an H×W×4 RGBA uint8 array (renders a frame)."""
-        from PySide6.QtGui import QImage
+        """The current picture as an H×W×4 RGBA uint8 array (renders a frame).
 
+        A GL window that has not been shown yet (another tab is current) has no context:
+        the picture is then drawn by the same renderer into an offscreen framebuffer."""
         from qtanimator.render.painter2d import image_to_array
 
-        return image_to_array(self.grabFramebuffer().convertToFormat(QImage.Format.Format_RGBA8888))
+        if isinstance(self.gl, _GLWindowSurface):
+            if not self.gl.isValid():
+                return self._render_offscreen()
+            # QOpenGLWindow.grabFramebuffer reads what is in the back buffer: draw it first.
+            from OpenGL import GL
+
+            self.gl.makeCurrent()
+            self.paint_gl()
+            GL.glFinish()
+        return image_to_array(self.gl.grabFramebuffer().convertToFormat(QImage.Format.Format_RGBA8888))
+
+    def _render_offscreen(self) -> np.ndarray:
+        from qtanimator.render.render3d import OffscreenGL
+
+        ratio = self.devicePixelRatioF()
+        size = (max(1, int(self.width() * ratio)), max(1, int(self.height() * ratio)))
+        if self._offscreen is None:
+            gl = OffscreenGL(size)
+            renderer = SceneRenderer()
+            renderer.initialize()
+            self._offscreen = (gl, renderer)
+        gl, renderer = self._offscreen
+        gl.make_current()
+        if gl.size != size:
+            gl.resize(size)
+        gl.bind()
+        self._draw(renderer, *size)
+        from OpenGL import GL
+
+        GL.glFinish()
+        return gl.read()
 
     # ------------------------------------------------------------- camera
     def restore_camera(self) -> bool:
@@ -395,8 +499,10 @@ class Viewport3D(QOpenGLWidget):
     def mousePressEvent(self, event: QMouseEvent) -> None:
         pos = event.position()
         self._press_pos = QPointF(pos)
+        self._end_gesture()   # a second button during a drag: the first drag ends here
         button, mods = event.button(), event.modifiers()
         mode = "orbit"
+        extra: dict[str, Any] = {}
         if button == Qt.MouseButton.MiddleButton or (
                 button == Qt.MouseButton.LeftButton and mods & Qt.KeyboardModifier.ShiftModifier):
             mode = "pan"
@@ -406,16 +512,24 @@ class Viewport3D(QOpenGLWidget):
             light = self.pick_light(pos)
             if light is not None:
                 mode = "light"
-                self._light_drag = (light, ("light-drag", next(_gestures)))
+                extra = {"light": light, "gesture": self.ctx.begin_gesture(f"Move {light}")}
             elif self._start_grab(pos):
                 mode = "grab"
             else:
                 mode = "click-orbit"
         elif button == Qt.MouseButton.RightButton:
-            mode = "ik" if self._start_ik(pos) else "zoom"
-        self._drag = {"mode": mode, "last": QPointF(pos), "moved": False, **(self._drag or {})} \
-            if mode == "ik" else {"mode": mode, "last": QPointF(pos), "moved": False}
+            ik = self._start_ik(pos)
+            mode = "ik" if ik is not None else "zoom"
+            extra = ik or {}
+        self._drag = {"mode": mode, "last": QPointF(pos), "moved": False, **extra}
         event.accept()
+
+    def _end_gesture(self) -> None:
+        """Commit the gesture of a drag in progress (one undo step) and forget the drag."""
+        drag, self._drag = self._drag, None
+        gesture = drag.get("gesture") if drag else None
+        if gesture is not None:
+            gesture.commit()
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
         if self._drag is None:
@@ -443,7 +557,8 @@ class Viewport3D(QOpenGLWidget):
         self.update()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
-        drag, self._drag = self._drag, None
+        drag = self._drag
+        self._end_gesture()
         if drag is None:
             return
         if drag["mode"] == "click-orbit" and not drag["moved"]:
@@ -453,8 +568,7 @@ class Viewport3D(QOpenGLWidget):
             else:
                 self.ctx.select(hit[0], self._joint_key(hit[0], hit[1]))
         elif drag["mode"] == "grab":
-            for cloth in self.live.cloths.values():
-                cloth.release()
+            self.live.release()
         self.update()
 
     def wheelEvent(self, event: QWheelEvent) -> None:
@@ -467,33 +581,33 @@ class Viewport3D(QOpenGLWidget):
         """Move the dragged light in the plane through it facing the camera (one undo step)."""
         from qtanimator.document.commands import SetParameter
 
-        name, gesture = self._light_drag
+        assert self._drag is not None
+        name, gesture = self._drag["light"], self._drag["gesture"]
         anchor = next(l.position for n, l in zip(LIGHT_NAMES, lights_of(self.ctx.doc)) if n == name)
         target = self._on_view_plane(pos, anchor)
-        if target is None:
+        if target is None or not gesture.active:
             return
         value = [round(float(v), 4) for v in target]
-        self.ctx.push(SetParameter(self.ctx.doc, f"{name}.position", value, text=f"Move {name}", gesture=gesture))
+        gesture.update(SetParameter(self.ctx.doc, f"{name}.position", value, text=f"Move {name}"))
 
     # ---------------------------------------------------------- cloth grab
     def _start_grab(self, pos: QPointF) -> bool:
         if not self.live.enabled:
             return False
         origin, direction = self.ray_at(pos)
-        for asset_id, cloth in self.live.cloths.items():
-            scale = max(cloth.params.width, cloth.params.height) / max(cloth.params.cols, cloth.params.rows)
-            if cloth.grab(origin, direction, max_distance=2.5 * scale) is not None:
-                p = cloth.positions[cloth.grabbed]
-                self._grab = (asset_id, p.copy(), self.camera.eye())
-                return True
-        return False
+        hit = self.live.grab(origin, direction,
+                             max_distance=lambda p: 2.5 * max(p.width, p.height) / max(p.cols, p.rows))
+        if hit is None:
+            return False
+        asset_id, point = hit
+        self._grab = (asset_id, point, self.camera.eye())
+        return True
 
     def _drag_grab(self, pos: QPointF) -> None:
         asset_id, anchor, _eye = self._grab
         target = self._on_view_plane(pos, anchor)
-        cloth = self.live.cloths.get(asset_id)
-        if cloth is not None and target is not None:
-            cloth.drag_grabbed(target)
+        if target is not None:
+            self.live.drag_grabbed(asset_id, target)
 
     def _on_view_plane(self, pos: QPointF, anchor: np.ndarray) -> np.ndarray | None:
         """Where the mouse ray meets the plane through ``anchor`` facing the camera."""
@@ -507,20 +621,21 @@ class Viewport3D(QOpenGLWidget):
         return origin + t * direction
 
     # ------------------------------------------------------------------ IK
-    def _start_ik(self, pos: QPointF) -> bool:
+    def _start_ik(self, pos: QPointF) -> dict[str, Any] | None:
+        """Begin a right-drag IK gesture on the joint under ``pos`` (None: nothing to drag)."""
         hit = self.pick(pos)
         if hit is None:
-            return False
+            return None
         asset_id, joint, _t = hit
         runtime = self.ctx.doc.runtime.get(asset_id)
         skel = getattr(runtime, "skeleton", None)
         if skel is None or not ik_dofs(skel, joint, self.ik_chain_length):
-            return False   # nothing can move this joint (the root): right-drag zooms
-        self.ctx.select(asset_id, self._joint_key(asset_id, joint))
+            return None   # nothing can move this joint (the root): right-drag zooms
+        key = self._joint_key(asset_id, joint)
+        self.ctx.select(asset_id, key)
         world = self._pose(asset_id).world_matrices()
-        self._drag = {"asset": asset_id, "joint": joint, "anchor": world[joint, :3, 3].copy(),
-                      "gesture": ("ik3d", next(_gestures)), "pushed": 0}
-        return True
+        return {"asset": asset_id, "joint": joint, "anchor": world[joint, :3, 3].copy(),
+                "gesture": self.ctx.begin_gesture(f"IK drag {key}")}
 
     def _pose(self, asset_id: str) -> Any:
         from qtanimator.document import character3d
@@ -541,10 +656,9 @@ class Viewport3D(QOpenGLWidget):
         if not result.values:
             return
         values = {(j, axis): v for (j, axis), v in result.by_axis_name().items()}
-        cmd = character3d.set_dofs_command(self.ctx.doc, asset_id, values, self.ctx.time,
-                                           gesture=self._drag["gesture"])
-        self.ctx.push(cmd)
-        self._drag["pushed"] += 1
+        gesture = self._drag["gesture"]
+        if gesture.active:
+            gesture.update(character3d.set_dofs_command(self.ctx.doc, asset_id, values, self.ctx.time))
 
     # ----------------------------------------------------------------- keys
     def keyPressEvent(self, event: QKeyEvent) -> None:
@@ -564,11 +678,8 @@ class Viewport3D(QOpenGLWidget):
         elif key == Qt.Key.Key_R:
             self.live.reset()
             self.update()
-        elif key == Qt.Key.Key_Escape and self._drag is not None and self._drag.get("mode") == "ik":
-            if self._drag.get("pushed"):
-                from qtanimator.ui.undo import drop_gesture
-
-                drop_gesture(self.ctx.undo_stack, self.ctx.doc, self._drag["gesture"])
+        elif key == Qt.Key.Key_Escape and self._drag is not None and self._drag.get("mode") in ("ik", "light"):
+            self._drag["gesture"].abort()   # the document goes back exactly; nothing to undo
             self._drag = None
             self.update()
         else:
@@ -815,10 +926,35 @@ class ViewportPanel(QWidget):
 
     def _on_frame_rendered(self, ms: float) -> None:
         text = f"{ms:.1f} ms"
+        if self.view.cloth_stale:
+            text = f"cloth still simulating (an earlier frame is shown)  ·  {text}"
         if self.view.last_error:
             text = f"{self.view.last_error}  ·  {text}"
         self.status.setText(text)
         self.status.setToolTip(text)
+
+
+def grab_with_3d(widget: QWidget) -> QPixmap:
+    """``widget.grab()`` with the 3D views inside it drawn in: a GL window in a window
+    container is shown by the window system and is not part of a widget grab
+    (screenshots use this)."""
+    from PySide6.QtCore import QPoint, QRect
+    from PySide6.QtGui import QPainter
+
+    pixmap = widget.grab()
+    views = [widget] if isinstance(widget, Viewport3D) else []
+    views += widget.findChildren(Viewport3D)
+    painter = QPainter(pixmap)
+    for view in views:
+        if view.surface_kind != "window" or not view.isVisible():
+            continue
+        rgba = np.ascontiguousarray(view.render_image())
+        h, w = rgba.shape[:2]
+        image = QImage(rgba.data, w, h, 4 * w, QImage.Format.Format_RGBA8888).copy()
+        origin = view.mapTo(widget, QPoint(0, 0)) if view is not widget else QPoint(0, 0)
+        painter.drawImage(QRect(origin, view.size()), image)
+    painter.end()
+    return pixmap
 
 
 def install(window: Any) -> None:
@@ -831,4 +967,4 @@ def install(window: Any) -> None:
     window.view_menu.addAction(frame)
 
 
-__all__ = ["ClipControls", "LiveCloths", "Viewport3D", "ViewportPanel", "install", "ClothDraw"]
+__all__ = ["ClipControls", "ClothDraw", "LiveCloths", "Viewport3D", "ViewportPanel", "grab_with_3d", "install"]

@@ -452,3 +452,59 @@ def test_dragging_a_grabbed_pin_moves_the_pin() -> None:
     for _ in range(3):
         cloth.step(DT)
     assert np.array_equal(cloth.positions[0], corner + (-0.2, 0.1, 0.0))
+
+
+@pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed")
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_drag_kernel_equals_the_numpy_drag_on_a_random_cloth(seed: int) -> None:
+    """The compiled per-triangle drag (cloth_kernels.drag_forces) against the numpy fallback:
+    a crumpled cloth moving at random through a gusty wind, forces equal to 1e-12."""
+    rng = np.random.default_rng(seed)
+    p = ClothParams(rows=11, cols=13, wind=tuple(rng.normal(0.0, 4.0, 3)), turbulence=2.5, turbulence_seed=seed,
+                    drag_coefficient=1.3, air_density=1.225)
+    fast, slow = Cloth(p, accelerate=True), Cloth(p, accelerate=False)
+    x = fast.rest_positions + rng.normal(0.0, 0.05, fast.rest_positions.shape)
+    v = rng.normal(0.0, 3.0, x.shape)
+    for cloth in (fast, slow):
+        cloth.time = 0.37
+        cloth._air = cloth._wind_at(x)
+    assert np.array_equal(fast._air, slow._air)
+    f_fast, f_slow = np.zeros_like(x), np.zeros_like(x)
+    fast._add_drag(x, v, f_fast)
+    slow._add_drag(x, v, f_slow)
+    assert np.abs(f_slow).max() > 0.1
+    np.testing.assert_allclose(f_fast, f_slow, rtol=1e-12, atol=1e-12)
+
+
+def test_a_step_asked_to_stop_puts_the_cloth_back_and_resumes_identically() -> None:
+    from qtanimator.core.cloth import ClothStepCancelled
+
+    p = ClothParams(rows=7, cols=9, wind=(3.0, 0.0, 1.0), turbulence=1.0, substeps=6)
+    ref, cloth = Cloth(p), Cloth(p)
+    for _ in range(3):
+        ref.step(DT)
+        cloth.step(DT)
+    before = cloth.state()
+    asked = []
+    with pytest.raises(ClothStepCancelled):
+        cloth.step(DT, should_stop=lambda: asked.append(1) is None and len(asked) > 4)
+    after = cloth.state()
+    assert len(asked) == 5 and cloth.error is None
+    assert np.array_equal(before.positions, after.positions) and np.array_equal(before.velocities, after.velocities)
+    assert before.time == after.time
+    for _ in range(4):
+        ref.step(DT)
+        cloth.step(DT, should_stop=lambda: False)
+    assert np.array_equal(ref.positions, cloth.positions) and np.array_equal(ref.velocities, cloth.velocities)
+
+
+def test_nearest_particle_to_a_ray() -> None:
+    from qtanimator.core.cloth import nearest_particle
+
+    cloth = Cloth(ClothParams(rows=5, cols=5, pin_mode="none"))
+    target = cloth.positions[12]
+    origin = target + np.array([0.0, 0.0, 4.0])
+    assert nearest_particle(cloth.positions, origin, (0.0, 0.0, -1.0)) == 12
+    assert nearest_particle(cloth.positions, origin, (0.0, 0.0, 1.0)) is None       # all behind
+    assert nearest_particle(cloth.positions, origin + [0.1, 0, 0], (0.0, 0.0, -1.0), max_distance=0.01) is None
+    assert cloth.grab(origin, (0.0, 0.0, -1.0)) == 12 and cloth.grabbed == 12

@@ -5,7 +5,7 @@ from __future__ import annotations
 from dataclasses import fields
 
 import pytest
-from PySide6.QtWidgets import QCheckBox, QComboBox, QDockWidget, QDoubleSpinBox, QPushButton, QSpinBox
+from PySide6.QtWidgets import QCheckBox, QComboBox, QDockWidget, QDoubleSpinBox, QLabel, QPushButton, QSpinBox
 
 from qtanimator.core.cloth import ClothParams
 from qtanimator.document.cloth import cloth_params
@@ -82,7 +82,7 @@ def test_interactive_pause_and_reset_drive_the_viewport_cloth(qtbot):
     cloth = view.live.cloths["cloth"]
     w.findChild(QPushButton, "clothPause").setChecked(True)
     assert view.live.paused
-    view.live.paused = False
+    assert view.live.settle()   # no step in flight any more: edits apply at once
     view.live.step(1 / 60)
     assert cloth.time > 0
     w.findChild(QPushButton, "clothReset").click()
@@ -133,3 +133,40 @@ def test_typed_wind_speed_is_one_exact_undo_step_per_edit(qtbot):
     assert cloth_params(doc, "cloth").wind == (6.0, 0.0, 1.5)
     assert speed.value() == pytest.approx(6.18, abs=0.01)
     assert [s.value() for s in w.cloth_panel.editors["wind"]] == [6.0, 0.0, 1.5]
+
+
+@pytest.mark.gl
+def test_long_cloth_work_shows_progress_and_can_be_cancelled(qtbot, monkeypatch):
+    """A stiff implicit cloth takes long to simulate: the edit returns at once, the dock
+    shows how far the background worker is, Cancel stops it and Resume goes on."""
+    from qtanimator.document.cloth import cloth_cache
+    from qtanimator.document.cloth_worker import cloth_worker
+    from qtanimator.ui import viewport
+
+    monkeypatch.setattr(cloth_panel.ClothPanel, "PROGRESS_AFTER_S", 0.0)
+    w = MainWindow(install_editors=False)
+    viewport.install(w)
+    cloth_panel.install(w)
+    qtbot.addWidget(w)
+    w.show()
+    w.cloth_panel.add_cloth()
+    worker = cloth_worker(w.doc)
+    assert worker.wait(60)
+    w.findChild(QDoubleSpinBox, "cloth_structural_stiffness").setValue(1.0e6)
+    w.findChild(QComboBox, "cloth_integrator").setCurrentText("implicit")
+    assert cloth_cache(w.doc, "cloth").cached_frames < 241      # the edit did not simulate
+    label = w.findChild(QLabel, "clothProgress")
+    button = w.findChild(QPushButton, "clothCancel")
+    qtbot.waitUntil(lambda: label.isVisible() and "Simulating cloth" in label.text(), timeout=10000)
+    assert button.isVisible() and button.text() == "Cancel"
+    button.click()
+    assert worker.wait(10)
+    assert "stopped" in label.text() and button.text() == "Resume"
+    button.click()
+    qtbot.waitUntil(lambda: "Simulating cloth" in label.text(), timeout=10000)
+    # Back to the explicit integrator: a new simulation, short; the progress goes away.
+    w.findChild(QComboBox, "cloth_integrator").setCurrentText("symplectic")
+    w.findChild(QDoubleSpinBox, "cloth_structural_stiffness").setValue(200.0)
+    assert worker.wait(60)
+    qtbot.waitUntil(lambda: not label.isVisible() and not button.isVisible(), timeout=5000)
+    w.ctx.undo_stack.setClean()

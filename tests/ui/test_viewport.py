@@ -5,8 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, Qt
-from PySide6.QtOpenGLWidgets import QOpenGLWidget
-from PySide6.QtWidgets import QTabWidget
+from PySide6.QtWidgets import QTabWidget, QWidget
 
 from qtanimator.render.gl.camera import OrbitCamera
 from qtanimator.ui import viewport
@@ -43,7 +42,7 @@ def test_install_adds_a_3d_tab_with_the_gl_view(window, qtbot):
     tabs = window.findChild(QTabWidget, "centralTabs")
     titles = [tabs.tabText(i) for i in range(tabs.count())]
     assert "3D" in titles
-    view = window.findChild(QOpenGLWidget, "viewport3d")
+    view = window.findChild(QWidget, "viewport3d")
     assert view is window.viewport3d
     fmt = view.format()
     assert (fmt.majorVersion(), fmt.minorVersion()) >= (3, 3) and fmt.depthBufferSize() >= 24
@@ -176,6 +175,7 @@ def test_cloth_keys_move_the_pins_of_the_live_cloth(window, qtbot):
     view.setFocus()
     view.set_live_cloth(True)
     view.live.paused = True
+    assert view.live.settle()   # paused: the live thread steps no more, edits apply at once
     cloth = view.live.cloths["cloth"]
     before = cloth.pin_targets.copy()
     qtbot.keyClick(view, Qt.Key.Key_D)
@@ -188,8 +188,7 @@ def test_cloth_keys_move_the_pins_of_the_live_cloth(window, qtbot):
     assert not np.allclose(cloth.pin_targets, before + [2 * viewport.PIN_STEP, viewport.PIN_STEP, 0.0])
     np.testing.assert_allclose(centre, before.mean(axis=0) + [2 * viewport.PIN_STEP, viewport.PIN_STEP, 0.0],
                                atol=1e-9)
-    view.live.paused = False
-    view.live.step(1 / 60)
+    view.live.step(1 / 60)      # one step now, on this thread
     np.testing.assert_allclose(cloth.positions[cloth.pinned], cloth.pin_targets, atol=1e-9)
     view.live.reset()
     np.testing.assert_allclose(cloth.pin_targets, before)
@@ -206,15 +205,16 @@ def test_mouse_grab_drags_the_live_cloth(window, qtbot):
     view._framed_once = True
     view.set_live_cloth(True)
     view.live.paused = True
+    assert view.live.settle()
     cloth = view.live.cloths["cloth"]
     w, h = view.width(), view.height()
-    corner = cloth.positions[-1].copy()   # bottom right, not pinned
+    corner = view.live.frame("cloth").positions[-1].copy()   # bottom right, not pinned
+    np.testing.assert_array_equal(corner, cloth.positions[-1])
     px = view.camera.project(corner, w, h)[0]
     a = QPoint(int(round(px[0])), int(round(px[1])))
     qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=a)
     assert cloth.grabbed is not None
     qtbot.mouseMove(view, a + QPoint(30, 0))
-    view.live.paused = False
     view.live.step(1 / 60)
     assert cloth.positions[cloth.grabbed][0] > corner[0] + 0.05
     qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=a + QPoint(30, 0))
@@ -299,7 +299,10 @@ def test_f_frames_the_selection_and_escape_cancels_an_ik_drag(window, qtbot, sha
     steps = window.ctx.undo_stack.count()
     qtbot.mousePress(view, Qt.MouseButton.RightButton, pos=a)
     qtbot.mouseMove(view, a + QPoint(0, -20))
-    assert window.ctx.undo_stack.count() == steps + 1
+    # the drag previews on the document (a gesture); the undo step comes at release
+    moved = pose_skeleton(window.doc, "mit", 0.0).world_matrices()[14, :3, 3]
+    assert np.linalg.norm(moved - p0) > 1e-3
+    assert window.ctx.undo_stack.count() == steps
     qtbot.keyClick(view, Qt.Key.Key_Escape)
     qtbot.mouseRelease(view, Qt.MouseButton.RightButton, pos=a + QPoint(0, -20))
     np.testing.assert_allclose(pose_skeleton(window.doc, "mit", 0.0).world_matrices()[14, :3, 3], p0, atol=1e-9)
@@ -342,11 +345,17 @@ def test_live_cloth_runs_on_the_timer_at_a_fixed_step(window, qtbot):
     view = window.viewport3d
     view.set_live_cloth(True)
     cloth = view.live.cloths["cloth"]
-    qtbot.waitUntil(lambda: cloth.time > 0.05, timeout=5000)
-    steps = cloth.time / viewport.SIM_DT
-    assert abs(steps - round(steps)) < 1e-6
+    # The live thread steps it; the view draws the snapshots it publishes.
+    qtbot.waitUntil(lambda: view.live.frame("cloth").time > 0.05, timeout=5000)
     view.live.paused = True
+    assert view.live.settle()
     t = cloth.time
+    steps = t / viewport.SIM_DT
+    assert abs(steps - round(steps)) < 1e-6
+    snapshot = view.live.frame("cloth")
+    assert snapshot.time == t
+    (item,) = view.build_items()
+    np.testing.assert_array_equal(item.positions, snapshot.positions)
     qtbot.wait(100)
     assert cloth.time == t
     view.set_live_cloth(False)
@@ -453,3 +462,57 @@ def test_camera_is_saved_with_the_project_without_an_undo_step_and_restored(qtbo
     w.ctx.push(add_character3d_command(w.doc, arm / "arm.skel", arm / "arm.skin", asset_id="arm2"))
     import3d.show_character(w, "arm2")
     assert view.camera_state() != moved
+
+
+def test_cloth_is_simulated_off_the_ui_thread_and_the_view_never_waits(window, qtbot):
+    """A frame the cloth cache does not have yet: the view draws the newest cached one,
+    asks the worker for the rest, and repaints when it is there."""
+    from qtanimator.core.cloth import ClothParams
+    from qtanimator.document.cloth import add_cloth_command, cloth_cache
+    from qtanimator.document.cloth_worker import cloth_worker
+
+    params = ClothParams(rows=10, cols=10, wind=(0.0, 0.0, 2.0))
+    window.ctx.push(add_cloth_command(window.doc, params))
+    view = window.viewport3d
+    worker = cloth_worker(window.doc)
+    assert view.cloth_worker is worker
+    worker.cancel()                          # hold the worker: the cache stops where it is
+    assert worker.wait(10)
+    cache = cloth_cache(window.doc, "cloth")
+    done = cache.cached_frames
+    window.ctx.set_frame(done + 40.0)
+    (item,) = view.build_items()
+    assert item.stale and view.cloth_stale
+    np.testing.assert_array_equal(item.positions, cache.frames[done - 1])
+    assert cache.cached_frames == done       # drawing did not simulate
+    worker.resume()
+    assert worker.wait(60)
+    qtbot.waitUntil(lambda: not view.cloth_stale, timeout=5000)   # the poll repainted it
+    (item,) = view.build_items()
+    assert not item.stale
+    from qtanimator.core.cloth import Cloth
+
+    direct = Cloth(params)
+    for _ in range(done + 40):
+        direct.step(1 / 60)
+    np.testing.assert_array_equal(item.positions, direct.positions)
+
+
+def test_escape_during_a_light_drag_puts_the_light_back_without_an_undo_step(window, qtbot):
+    view = window.viewport3d
+    view.camera = OrbitCamera(azimuth=0.0, inclination=0.0, distance=14.0, target=np.array([0.0, 3.0, 0.0]))
+    view._framed_once = True
+    view.render_image()
+    from qtanimator.render.gl.lights import lights_of
+
+    before = lights_of(window.doc)[0].position.copy()
+    px = view.camera.project(before, view.width(), view.height())[0]
+    a = QPoint(int(round(px[0])), int(round(px[1])))
+    view.setFocus()
+    qtbot.mousePress(view, Qt.MouseButton.LeftButton, pos=a)
+    qtbot.mouseMove(view, a + QPoint(-20, 0))
+    assert np.array(window.doc.parameters["light1.position"])[0] < before[0] - 0.1   # previewed
+    qtbot.keyClick(view, Qt.Key.Key_Escape)
+    qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=a + QPoint(-20, 0))
+    np.testing.assert_allclose(lights_of(window.doc)[0].position, before)
+    assert window.ctx.undo_stack.count() == 0 and not window.ctx.undo_stack.canRedo()

@@ -104,6 +104,7 @@ class ClothDraw:
     color: tuple[float, float, float, float] = CLOTH_COLOR
     spheres: list[tuple[np.ndarray, float]] = field(default_factory=list)
     pinned: np.ndarray | None = None     # (P, 3) pinned particle positions
+    stale: bool = False                  # an earlier frame stands in (the cache is still filling)
 
 
 @dataclass

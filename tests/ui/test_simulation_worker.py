@@ -1,0 +1,168 @@
+"""The pendulums in the real main window (the demo project): a right-drag at frame 200 never
+simulates on the UI thread and restarts the worker at most once per change, the rig editor
+shows the latest state and repaints as the worker catches up, the timeline's cache bar shows
+the simulated frames, and closing the window stops the worker. No wall-clock asserts."""
+
+from __future__ import annotations
+
+import threading
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
+from PySide6.QtGui import QMouseEvent
+from PySide6.QtWidgets import QApplication, QWidget
+
+from qtanimator.document import character2d as c2d
+from qtanimator.document.document import DocumentChange
+from qtanimator.document.simulation import running_workers, shutdown_all
+from qtanimator.ui.timeline import CACHE_COLOR, CacheBar
+
+DEMO = Path(__file__).resolve().parents[2] / "scenes" / "demo" / "demo.qtanim"
+TIMEOUT_MS = 60_000  # a safety net against hangs, never a performance assertion
+
+
+@pytest.fixture
+def demo(make_window, qtbot):
+    window = make_window(editors=("rig_editor", "timeline", "joint_tree", "properties"))
+    assert window.open_path(DEMO)
+    window.central_tabs.setCurrentWidget(window.rig_editor)
+    view = window.rig_editor.view
+    view.fit_view()
+    qtbot.wait(10)
+    yield window, view
+    shutdown_all()
+    assert running_workers() == []
+
+
+def send_mouse(view, kind: QEvent.Type, pos: QPoint, button: Qt.MouseButton,
+               buttons: Qt.MouseButton) -> None:
+    vp = view.viewport()
+    local = QPointF(pos)
+    event = QMouseEvent(kind, local, vp.mapToGlobal(local), button, buttons, Qt.KeyboardModifier.NoModifier)
+    QApplication.sendEvent(vp, event)
+
+
+def hand_point(window, view) -> QPoint:
+    """A pixel on Pip's right hand that picks the hand (a keyframed joint: exact at once)."""
+    from qtanimator.ui.rig_interaction import pick
+
+    doc = window.doc
+    ch = doc.runtime["pip"]
+    j = ch.joint_index("hand_right")
+    pose = c2d.evaluate_pose(doc, "pip", window.ctx.time, block=False)
+    pts = ch.joints[j].shapes[0].points
+    centre = pts.mean(axis=0)
+    for local in [centre] + [centre + 0.5 * (p - centre) for p in pts]:
+        xy = view.from_scene(pose.to_world(j, local))
+        pixel = QPoint(int(round(xy.x())), int(round(xy.y())))
+        if pick(doc, window.ctx.time, view.to_scene(QPointF(pixel))) == ("pip", j):
+            return pixel
+    raise AssertionError("the hand is covered everywhere")
+
+
+def ui_steps(sim: c2d.PendulumCache) -> int:
+    return sim.steps_by_thread.get(threading.get_ident(), 0)
+
+
+def test_a_drag_at_frame_200_never_simulates_on_the_ui_thread(demo, qtbot):
+    window, view = demo
+    doc, ctx = window.doc, window.ctx
+    sim = c2d.simulation(doc)
+    ctx.set_frame(200)
+    view.viewport().repaint()
+    qtbot.waitUntil(lambda: not sim.busy, timeout=TIMEOUT_MS)
+    changes: list[DocumentChange] = []
+    doc.subscribe(changes.append)
+    restarts, invalidations, steps = sim.restarts, sim.invalidations, sim.steps_taken
+    assert ui_steps(sim) == 0
+    press = hand_point(window, view)
+    send_mouse(view, QEvent.Type.MouseButtonPress, press, Qt.MouseButton.RightButton, Qt.MouseButton.RightButton)
+    moves = 8
+    for i in range(1, moves + 1):
+        send_mouse(view, QEvent.Type.MouseMove, press + QPoint(2 * i, -i), Qt.MouseButton.NoButton,
+                   Qt.MouseButton.RightButton)
+        view.viewport().repaint()  # the frame drawn after this move: poses, HUD, onion skin
+        QApplication.processEvents()
+    send_mouse(view, QEvent.Type.MouseButtonRelease, press + QPoint(2 * moves, -moves),
+               Qt.MouseButton.RightButton, Qt.MouseButton.NoButton)
+    assert ctx.undo_stack.count() == 1 and len(changes) == moves  # one change per move
+    assert ui_steps(sim) == 0  # every pendulum step of the drag ran on the worker thread
+    assert sim.restarts - restarts <= len(changes)
+    assert sim.invalidations - invalidations <= len(changes)  # one character per change
+    # The worker catches up; the editor then shows exactly the synchronous frame.
+    qtbot.waitUntil(lambda: not sim.busy and c2d.simulation_ready(doc, ctx.time), timeout=TIMEOUT_MS)
+    assert sim.steps_taken > steps
+    view.viewport().repaint()
+    assert np.array_equal(view.poses()["pip"].world, c2d.evaluate_pose(doc, "pip", ctx.time).world)
+    assert ui_steps(sim) == 0
+
+
+def test_the_editor_shows_the_latest_state_and_repaints_as_frames_arrive(demo, qtbot):
+    window, view = demo
+    doc, ctx = window.doc, window.ctx
+    sim = c2d.simulation(doc)
+    qtbot.waitUntil(lambda: not sim.busy, timeout=TIMEOUT_MS)
+    held: list[int] = []
+    wake = sim.worker.wake
+    sim.worker.wake = lambda: held.append(1)  # the worker is slow today: it does nothing yet
+    sim.invalidate()  # start from nothing simulated
+    t = 150 / doc.fps
+    ctx.set_frame(150)
+    view.viewport().repaint()
+    assert held and sim.cached_frames("pip") == 0 and ui_steps(sim) == 0
+    lantern = doc.runtime["pip"].joint_index("lantern")
+    start = c2d.simulation(doc).latest_state("pip", 0)[0][lantern]
+    assert view.poses()["pip"].world_angles[lantern] == pytest.approx(start, abs=1e-12)  # keyed start
+    assert view._simulation_pending
+    drawn = view.frames_drawn
+    sim.worker.wake = wake
+    wake()
+    # No frame change, no edit: only the simulation's progress repaints the editor.
+    qtbot.waitUntil(lambda: not view._simulation_pending, timeout=TIMEOUT_MS)
+    assert view.frames_drawn > drawn
+    assert view._poses_exact
+    assert np.array_equal(view.poses()["pip"].world, c2d.evaluate_pose(doc, "pip", t).world)
+    assert ui_steps(sim) == 0
+
+
+def test_the_cache_bar_shows_the_simulated_frames(demo, qtbot):
+    window, view = demo
+    doc, ctx = window.doc, window.ctx
+    timeline = window.findChild(QWidget, "timeline")
+    bar = window.findChild(QWidget, "cacheBar")
+    assert isinstance(bar, CacheBar) and bar.parent() is timeline
+    assert bar.geometry().top() >= timeline.height() - 6  # a strip under the ruler
+    sim = c2d.simulation(doc)
+    progressed: list[int] = []
+    ctx.simulationProgressed.connect(lambda: progressed.append(1))
+    refreshes = bar.refreshes
+    ctx.set_frame(100)
+    view.viewport().repaint()
+    qtbot.waitUntil(lambda: not sim.busy and bar.simulated() == c2d.simulated_frames(doc), timeout=TIMEOUT_MS)
+    first, last = bar.simulated()
+    assert first == 0 and last >= 100
+    assert bar.toolTip() == f"Simulated frames 0–{last}"
+    # Updated at most once per progress report (once per frame) plus once per document change.
+    assert bar.refreshes - refreshes <= len(progressed) + 1
+    image = bar.grab().toImage()
+    y = bar.height() // 2
+    assert image.pixelColor(int(timeline.frame_to_x(50)), y) == CACHE_COLOR
+    assert image.pixelColor(int(timeline.frame_to_x(min(last + 20, 240))), y) != CACHE_COLOR
+    # An edit at frame 200 drops Pip's frames from its previous key but one (2 s = frame 120).
+    sim.worker.wake = lambda: None  # keep the worker from refilling while we look
+    pip = doc.runtime["pip"]
+    ctx.push(c2d.key_joint(doc, "pip", pip.joint_index("upper_arm_right"), 0.9, 200 / doc.fps))
+    assert bar.simulated() == (0, 119)
+    assert bar.toolTip() == "Simulated frames 0–119"
+
+
+def test_closing_the_window_stops_the_worker(demo, qtbot):
+    window, view = demo
+    sim = c2d.simulation(window.doc)
+    window.ctx.set_frame(120)
+    view.viewport().repaint()
+    assert sim.worker.alive
+    window.close()
+    assert not sim.worker.alive
