@@ -26,7 +26,7 @@ import time as _time
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QElapsedTimer, QPointF, Qt, QTimer, Signal
+from PySide6.QtCore import QElapsedTimer, QObject, QPointF, Qt, QTimer, Signal
 from PySide6.QtGui import QImage, QKeyEvent, QMouseEvent, QPixmap, QSurfaceFormat, QWheelEvent
 from PySide6.QtOpenGL import QOpenGLWindow
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
@@ -185,6 +185,11 @@ class Viewport3D(QWidget):
         self.gl: _GLWindowSurface | _GLWidgetSurface
         if self.surface_kind == "window":
             self.gl = _GLWindowSurface(self)
+            # The container deletes its window, but PySide counts a window made in Python
+            # as Python's: at exit PySide would delete it before the container, which then
+            # touches a dangling pointer (a crash in QApplication's destructor). A QObject
+            # parent first hands it to C++; the container then reparents it as it needs.
+            QObject.setParent(self.gl, self)
             container = QWidget.createWindowContainer(self.gl, self)
             container.setObjectName("viewport3dSurface")
             container.setFocusPolicy(Qt.FocusPolicy.NoFocus)
