@@ -35,7 +35,7 @@ import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Key
 from qtanimator.core.ik import gradient_descent_step, solve_ik
-from qtanimator.core.pendulum import PRESETS, PendulumParams, PendulumSystem
+from qtanimator.core.pendulum import PRESETS, PendulumBlowUp, PendulumParams, PendulumSystem, check_state
 from qtanimator.core.rig2d import Character, Pose
 from qtanimator.document.commands import AddAsset, Command, DeleteKeys, Macro, SetKeys, SetParameter
 from qtanimator.document.document import Asset, Document, DocumentChange, channel_id, split_channel_id
@@ -324,6 +324,8 @@ class _AssetSim:
         self.omega: list[FloatArray] = []
         #: Bumped by an invalidation that reaches the frame being computed (see PendulumCache).
         self.generation = 0
+        #: Why the simulation stopped after its last cached frame (a blow-up), or None.
+        self.problem: PendulumBlowUp | None = None
         n = len(ch.joints)
         key_sum = np.zeros((n, n))
         dyn_pick = np.zeros((n, n))
@@ -490,6 +492,7 @@ class PendulumCache:
             return False  # neither a cached frame nor the one being computed is affected
         # The frame being computed (index len) may read the old inputs: make it stale too.
         sim.generation += 1
+        sim.problem = None  # the frame that blew up is recomputed from the new inputs
         del sim.theta[keep:]
         del sim.omega[keep:]
         self.revision += 1
@@ -508,6 +511,12 @@ class PendulumCache:
             restart = dropped and bool(self._targets)
         if restart:
             self._worker.wake()
+
+    def problem(self, asset_id: str) -> PendulumBlowUp | None:
+        """The blow-up that stopped this character's simulation, or None."""
+        with self._lock:
+            sim = self._sims.get(asset_id)
+            return None if sim is None else sim.problem
 
     def cached_frames(self, asset_id: str) -> int:
         sim = self._sims.get(asset_id)
@@ -542,6 +551,8 @@ class PendulumCache:
                 n = len(sim.theta)
                 if n > f:
                     return sim.theta[f], sim.omega[f]
+                if sim.problem is not None and n:
+                    return sim.theta[-1], sim.omega[-1]  # it stops at the last good frame
                 gen = sim.generation
                 prev = (sim.theta[-1], sim.omega[-1]) if n else None
             self._step(doc, asset_id, sim, gen, n, prev)
@@ -639,6 +650,8 @@ class PendulumCache:
             for aid, target in list(self._targets.items()):
                 sim = self._sims.get(aid)
                 n = 0 if sim is None else len(sim.theta)
+                if sim is not None and sim.problem is not None:
+                    continue  # blown up: nothing more to simulate until an edit
                 if n <= target and (best is None or n < best[0]):
                     best = (n, aid)
             if best is None:
@@ -675,10 +688,16 @@ class PendulumCache:
         else:
             theta, omega, steps = self._advance(doc, asset_id, sim, start + index - 1, prev[0], prev[1])
         ident = threading.get_ident()
+        problem = check_state(sim.system.character, sim.system.params, theta, omega, (start + index) / doc.fps)
         with self._lock:
             self.steps_taken += steps
             self.steps_by_thread[ident] += steps
             if self._sims.get(asset_id) is not sim or sim.generation != generation or len(sim.theta) != index:
+                return False
+            if problem is not None:
+                # Stop at the last good frame: nothing non-finite reaches a view or a file.
+                sim.problem = problem
+                self.revision += 1
                 return False
             sim.theta.append(theta)
             sim.omega.append(omega)
@@ -804,6 +823,15 @@ def simulated_frames(doc: Document) -> tuple[int, int] | None:
     if not counts:
         return None
     return first, first + min(counts) - 1
+
+
+def pendulum_problems(doc: Document) -> dict[str, PendulumBlowUp]:
+    """The blow-ups that stopped the pendulum simulations, by character."""
+    cache = doc.caches.get(PENDULUM_CACHE)
+    if not isinstance(cache, PendulumCache):
+        return {}
+    found = {aid: cache.problem(aid) for aid in character_assets(doc)}
+    return {aid: p for aid, p in found.items() if p is not None}
 
 
 def channel_for(doc: Document, asset_id: str, joint_index: int) -> Channel | None:

@@ -74,12 +74,14 @@ class PropertiesPanel(QWidget):
         self.scroll.setWidgetResizable(True)
         outer.addWidget(self.scroll)
         self.body: QWidget | None = None
+        self._simulation_refreshers: list[Callable[[], None]] = []
         self._refreshers: list[Callable[[], None]] = []
         self.editors: dict[str, QWidget] = {}
         ctx.selectionChanged.connect(lambda _a, _j: self.rebuild())
         ctx.documentReset.connect(self.rebuild)
         ctx.documentChanged.connect(self._on_document)
         ctx.frameChanged.connect(lambda _f: self.refresh())
+        ctx.simulationProgressed.connect(lambda: [fn() for fn in self._simulation_refreshers])
         self.rebuild()
 
     # ------------------------------------------------------------ structure
@@ -103,6 +105,7 @@ class PropertiesPanel(QWidget):
 
     def rebuild(self) -> None:
         self._refreshers = []
+        self._simulation_refreshers = []
         self.editors = {}
         body = QWidget()
         layout = QVBoxLayout(body)
@@ -326,6 +329,20 @@ class PropertiesPanel(QWidget):
             editor.setToolTip(f"default {getattr(defaults, f.name)!r}")
             # What is shown is the effective value (preset + overrides).
             self._refreshers.append(self._effective_refresher(editor, asset, f.name))
+        problem = QLabel()
+        problem.setObjectName("pendulumProblem")
+        problem.setWordWrap(True)
+        problem.setStyleSheet("color: #c0392b;")
+
+        def refresh_problem() -> None:
+            report = m2.simulation(doc).problem(asset)
+            problem.setText("" if report is None else f"Stopped: {report.message}")
+            problem.setVisible(report is not None)
+
+        refresh_problem()
+        self._simulation_refreshers.append(refresh_problem)
+        self._refreshers.append(refresh_problem)
+        form.addRow(problem)
         return group
 
     def _effective_refresher(self, editor: QWidget, asset: str, name: str) -> Callable[[], None]:

@@ -12,7 +12,7 @@ import bisect
 import math
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QPointF, QRectF, QSize, Qt
+from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
 from PySide6.QtGui import (
     QAction,
     QColor,
@@ -51,6 +51,7 @@ MARGIN = 10
 CACHE_BAR_HEIGHT = 4
 #: Simulated frames (Blender draws its simulation caches as a coloured band too).
 CACHE_COLOR = QColor(80, 170, 255)
+FAILED_COLOR = QColor(230, 60, 50)
 
 
 def key_frames(ctx: EditorContext, asset: str | None = None) -> list[float]:
@@ -209,6 +210,9 @@ class CacheBar(QWidget):
     tool tip and accessible description. It lets mouse presses through to the ruler.
     """
 
+    #: The messages of the blow-ups that stopped a simulation (empty when none did).
+    problemsChanged = Signal(list)
+
     def __init__(self, timeline: TimelineWidget) -> None:
         super().__init__(timeline)
         self.setObjectName("cacheBar")
@@ -217,6 +221,8 @@ class CacheBar(QWidget):
         self.timeline = timeline
         self.ctx = timeline.ctx
         self._range: tuple[int, int] | None = None
+        #: Frames where a simulation blew up (drawn as red marks after the good frames).
+        self._failed: list[tuple[int, str]] = []
         #: How many times the band was recomputed (tests: at most once per progress signal).
         self.refreshes = 0
         self.ctx.simulationProgressed.connect(self.refresh)
@@ -229,6 +235,10 @@ class CacheBar(QWidget):
         character has pendulums."""
         return self._range
 
+    def failures(self) -> list[tuple[int, str]]:
+        """``(frame, message)`` of each blow-up that stopped a simulation."""
+        return list(self._failed)
+
     def refresh(self) -> None:
         from qtanimator.document import character2d as c2d
         from qtanimator.document.simulation import progress
@@ -238,17 +248,22 @@ class CacheBar(QWidget):
         simulated = c2d.simulated_frames(doc)
         if progress(doc)[1]:
             self.ctx.watch_simulation()  # follow the worker while it runs
-        if simulated != self._range:
-            self._range = simulated
+        failed = sorted((int(round(p.time * doc.fps)), p.message) for p in c2d.pendulum_problems(doc).values())
+        if simulated != self._range or failed != self._failed:
+            problems_changed = failed != self._failed
+            self._range, self._failed = simulated, failed
             if simulated is None:
                 text = "No simulation"
             elif simulated[1] < simulated[0]:
                 text = "Simulation: no frame simulated yet"
             else:
                 text = f"Simulated frames {simulated[0]}–{simulated[1]}"
+            text = "\n".join([text] + [f"Stopped at frame {f}: {m}" for f, m in failed])
             self.setToolTip(text)
             self.setAccessibleDescription(text)
             self.update()
+            if problems_changed:
+                self.problemsChanged.emit([m for _f, m in failed])
 
     def paintEvent(self, _event: QPaintEvent) -> None:
         p = QPainter(self)
@@ -261,6 +276,10 @@ class CacheBar(QWidget):
             b = self.timeline.frame_to_x(min(self._range[1], last))
             if b >= a:
                 p.fillRect(QRectF(a, 0, max(b - a, 1.0), h), CACHE_COLOR)
+        for frame, _message in self._failed:
+            if first <= frame <= last:
+                x = self.timeline.frame_to_x(frame)
+                p.fillRect(QRectF(x - 1.5, 0, 3.0, h), FAILED_COLOR)
         p.end()
 
 
@@ -484,5 +503,13 @@ def install(window: MainWindow) -> None:
         panel.fps_label.setText(f"{playback.measured_fps():.0f} fps, {playback.dropped_frames} dropped")
 
     playback.ticked.connect(update_rate)
+
+    def show_problems(messages: list[str]) -> None:
+        if messages:
+            window.statusBar().showMessage("Simulation stopped: " + messages[0])
+        else:
+            window.statusBar().clearMessage()
+
+    panel.timeline.cache_bar.problemsChanged.connect(show_problems)
     # Stop playing when the document is replaced.
     ctx.documentReset.connect(playback.pause)

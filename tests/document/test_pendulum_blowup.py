@@ -1,0 +1,62 @@
+"""A pendulum simulation that blows up stops at its last good frame and says why."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from qtanimator.document import character2d as c2d
+from qtanimator.document.commands import SetParameter, UndoStack
+from qtanimator.document.document import Document
+
+CLOCK = Path(__file__).resolve().parents[2] / "scenes" / "pendulum_clock.svg"
+
+
+@pytest.fixture
+def clock():
+    doc = Document()
+    stack = UndoStack(doc)
+    stack.push(c2d.add_characters_command(doc, CLOCK))
+    asset = next(iter(doc.assets))
+    assert doc.runtime[asset].dynamic.any()
+    yield doc, stack, asset
+    c2d.simulation(doc).shutdown()
+
+
+@pytest.mark.parametrize("name, value, parameter", [("damping", -200.0, "damping"), ("g", 1e12, "step")])
+def test_a_blow_up_stops_at_the_last_good_frame_and_names_the_setting(clock, name, value, parameter):
+    doc, stack, asset = clock
+    sim = c2d.simulation(doc)
+    assert sim.problem(asset) is None
+    theta_ok = sim.state(asset, 60)[0].copy()
+    stack.push(SetParameter(doc, f"{asset}.pendulum.{name}", value))
+    last_theta, _omega = sim.state(asset, 200)  # returns instead of simulating garbage
+    report = sim.problem(asset)
+    assert report is not None and report.parameter == parameter
+    good = sim.cached_frames(asset)
+    assert 0 < good < 200
+    assert report.time == pytest.approx((doc.frame_range[0] + good) / doc.fps)
+    # Nothing non-finite is kept: every cached frame is finite, and reads beyond stay at the last one.
+    for f in range(good):
+        assert np.isfinite(sim.state(asset, f)[0]).all()
+    np.testing.assert_array_equal(last_theta, sim.state(asset, good - 1)[0])
+    np.testing.assert_array_equal(sim.latest_state(asset, 150)[0], last_theta)
+    assert c2d.pendulum_problems(doc) == {asset: report}
+    # Undoing the setting clears the report and the simulation runs through again, as before.
+    stack.undo()
+    assert sim.problem(asset) is None
+    np.testing.assert_array_equal(sim.state(asset, 60)[0], theta_ok)
+    sim.state(asset, 200)
+    assert sim.problem(asset) is None and sim.cached_frames(asset) == 201
+
+
+def test_the_worker_stops_too_and_reports(clock):
+    doc, stack, asset = clock
+    sim = c2d.simulation(doc)
+    stack.push(SetParameter(doc, f"{asset}.pendulum.damping", -200.0))
+    sim.latest_state(asset, 150)  # a view asks: the worker fills in the background
+    assert sim.wait_idle(30.0)
+    assert sim.problem(asset) is not None
+    assert sim.cached_frames(asset) < 150

@@ -1,0 +1,37 @@
+"""Where the user looks when a simulation blows up: the Properties of the pendulum, the
+timeline's cache bar and the status bar."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from PySide6.QtWidgets import QLabel
+
+from qtanimator.document.commands import SetParameter
+
+CLOCK = Path(__file__).resolve().parents[2] / "scenes" / "pendulum_clock.svg"
+
+
+def test_a_pendulum_blow_up_is_shown_in_properties_cache_bar_and_status_bar(make_window, qtbot):
+    window = make_window(editors=("rig_editor", "timeline", "properties"))
+    assert window.open_path(CLOCK)
+    asset = next(iter(window.doc.assets))
+    window.ctx.select(asset, "")
+    bar = window.timeline_dock.widget().timeline.cache_bar
+    label = window.findChild(QLabel, "pendulumProblem")
+    assert label is not None and not label.isVisible()
+    window.ctx.push(SetParameter(window.doc, f"{asset}.pendulum.damping", -200.0))
+    window.ctx.set_frame(150.0)  # the editor asks for frame 150: the worker runs into the blow-up
+    qtbot.waitUntil(lambda: bool(bar.failures()), timeout=20000)
+    frame, message = bar.failures()[0]
+    assert 0 < frame < 150 and "damping" in message
+    assert bar.simulated() == (0, frame - 1)
+    assert "Stopped at frame" in bar.toolTip()
+    assert window.statusBar().currentMessage() == "Simulation stopped: " + message
+    label = window.findChild(QLabel, "pendulumProblem")
+    qtbot.waitUntil(label.isVisible, timeout=5000)
+    assert message in label.text()
+    # Undo: the report goes away everywhere.
+    window.ctx.undo_stack.undo()
+    qtbot.waitUntil(lambda: not bar.failures(), timeout=20000)
+    assert window.statusBar().currentMessage() == ""
