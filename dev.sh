@@ -33,6 +33,9 @@ install_system_packages() {
 }
 
 setup_venv() {
+  # Extras: test (pytest, linters) and fast (numba: the compiled cloth kernels; CI also runs
+  # the cloth tests without it, QTANIMATOR_NO_NUMBA=1). Exact versions come from
+  # constraints.txt; pyproject.toml holds the ranges a user's pip may choose from.
   local extras="$1"
   local python="${PYTHON:-python3}"
   if [ ! -x .venv/bin/python ]; then
@@ -40,11 +43,11 @@ setup_venv() {
   fi
   local stamp=".venv/.qtanimator-installed-$extras"
   local want
-  want="$(sha1sum pyproject.toml | cut -d' ' -f1)"
+  want="$(cat pyproject.toml setup.py constraints.txt | sha1sum | cut -d' ' -f1)"
   if [ ! -f "$stamp" ] || [ "$(cat "$stamp")" != "$want" ]; then
     echo "dev.sh: installing qtanimator and its dependencies into .venv" >&2
     .venv/bin/python -m pip install -q --upgrade pip
-    .venv/bin/python -m pip install -q -e ".[$extras]"
+    .venv/bin/python -m pip install -q -e ".[$extras]" -c constraints.txt
     echo "$want" >"$stamp"
   fi
 }
@@ -54,17 +57,17 @@ shift || true
 case "$cmd" in
   run)
     install_system_packages
-    setup_venv test
+    setup_venv test,fast
     exec .venv/bin/qtanimator "$@"
     ;;
   test)
     install_system_packages
-    setup_venv test
+    setup_venv test,fast
     exec .venv/bin/python -m pytest "$@"
     ;;
   bench)
     install_system_packages
-    setup_venv "test,bench"
+    setup_venv "test,fast,bench"
     exec .venv/bin/python -m benchmarks "$@"
     ;;
   *)

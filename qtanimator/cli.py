@@ -2,25 +2,37 @@
 
 Bad input gives a one-line error on stderr and a non-zero exit status, never a traceback.
 Set ``QTANIMATOR_DEBUG=1`` to get the traceback of an unexpected error instead.
+
+The GUI start checks for a display before Qt is started (Qt would abort the process), logs
+to a rotating file under the XDG state folder (:mod:`qtanimator.applog`; ``--verbose`` logs
+debug messages and copies the log to stderr) and installs the exception hook of
+:mod:`qtanimator.ui.errors`, so that an error in the window is logged and shown.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import logging
 import os
 import sys
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, NoReturn
 
-from qtanimator import __version__
+from qtanimator import __version__, applog
 from qtanimator.formats.errors import FormatError
 
-#: Exit statuses: 1 unreadable input, 2 bad usage, 70 internal error (sysexits EX_SOFTWARE).
+#: Exit statuses: 1 unreadable input, 2 bad usage (or no display for the GUI), 70 internal
+#: error (sysexits EX_SOFTWARE).
 EXIT_INPUT = 1
 EXIT_USAGE = 2
 EXIT_INTERNAL = 70
+
+NO_DISPLAY = "no display: run under a desktop session, or use `qtanimator render` for headless output"
+
+#: Qt platform plugins that need no window system (``QT_QPA_PLATFORM``).
+HEADLESS_PLATFORMS = frozenset({"offscreen", "minimal", "minimalegl", "vnc", "eglfs", "linuxfb", "vkkhrdisplay"})
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -77,17 +89,35 @@ def _render(args: list[str]) -> int:
     return int(render_main(args))
 
 
+def display_problem(environ: Mapping[str, str] | None = None, platform: str | None = None) -> str | None:
+    """Why the GUI cannot start here, or None. Only X11 / Wayland systems are checked: there
+    Qt aborts the whole process (SIGABRT) when it finds no display."""
+    env = os.environ if environ is None else environ
+    system = sys.platform if platform is None else platform
+    if system.startswith(("win", "cygwin", "darwin")):
+        return None
+    wanted = [p.split(":", 1)[0].strip() for p in env.get("QT_QPA_PLATFORM", "").split(";") if p.strip()]
+    if any(p in HEADLESS_PLATFORMS for p in wanted):
+        return None
+    if env.get("DISPLAY") or env.get("WAYLAND_DISPLAY"):
+        return None
+    return NO_DISPLAY
+
+
 def _gui(args: list[str]) -> int:
     parser = OneLineParser(
         prog="qtanimator",
         description="Character animation: 2D SVG rigs with IK and pendulums, a curve editor, "
                     "skinned 3D characters and cloth.",
         epilog="Subcommands: 'qtanimator render --help' renders without a window; "
-               "'qtanimator info --help' summarises a file.",
+               "'qtanimator info --help' summarises a file. "
+               f"The log file is {applog.log_path()}.",
     )
     parser.add_argument("path", nargs="?", help="a project (.qtanim), an SVG character or folder, "
                         "or a 3D file; the demo project when left out")
     parser.add_argument("--version", action="version", version=f"qtanimator {__version__}")
+    parser.add_argument("-v", "--verbose", action="store_true",
+                        help="log debug messages, to the log file and to stderr")
     ns = parser.parse_args(args)
 
     from qtanimator.paths import demo_project
@@ -95,22 +125,41 @@ def _gui(args: list[str]) -> int:
     path = Path(ns.path) if ns.path else demo_project()
     if ns.path and not path.exists():
         raise FormatError("no such file or folder.", path)
+    problem = display_problem()
+    if problem is not None:
+        _fail(problem)
+        return EXIT_USAGE
 
+    log_file = applog.setup_logging(ns.verbose)
+    log = logging.getLogger("qtanimator")
+    log.info("qtanimator %s starting (Python %s), log %s", __version__, sys.version.split()[0], log_file)
+
+    from PySide6.QtGui import QGuiApplication, QIcon
     from PySide6.QtWidgets import QApplication
 
+    from qtanimator.paths import APP_ID, app_icon_path
+    from qtanimator.ui.errors import install_excepthook
     from qtanimator.ui.main_window import MainWindow
 
     # Simulation and autosave workers share the GIL with the UI thread: hand it over every
     # millisecond (Python's default is 5 ms) so the UI's turn comes well inside a frame.
     sys.setswitchinterval(0.001)
+    # The desktop entry's name: Wayland compositors match windows to it (icon, grouping).
+    QGuiApplication.setDesktopFileName(APP_ID)
     app = QApplication.instance() or QApplication(sys.argv[:1])
     app.setApplicationName("qtanimator")
     app.setOrganizationName("qtanimator")
+    app.setApplicationVersion(__version__)
+    if isinstance(app, QGuiApplication):
+        app.setWindowIcon(QIcon(str(app_icon_path())))
+    install_excepthook()
     window = MainWindow()
     window.show()
     if path.exists():
         window.open_path(path)
-    return int(app.exec())
+    status = int(app.exec())
+    log.info("qtanimator exits with status %d", status)
+    return status
 
 
 def _info(args: list[str]) -> int:

@@ -117,3 +117,45 @@ def test_the_installed_command_runs_in_a_fresh_process(project, tmp_path):
     fail = subprocess.run([*cmd, "info", str(bad)], capture_output=True, text=True, env=env, timeout=60)
     assert fail.returncode == 1
     assert "Traceback" not in fail.stderr and len(fail.stderr.strip().splitlines()) == 1
+
+
+# ------------------------------------------------------------------ no display
+NO_DISPLAY_LINE = ("qtanimator: no display: run under a desktop session, or use `qtanimator render` for "
+                   "headless output")
+
+
+def test_no_display_is_one_line_and_exit_2_before_qt_starts(tmp_path):
+    """Qt would abort the process (SIGABRT) with a misleading xcb message; we say what to do."""
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY", "QT_QPA_PLATFORM")}
+    env["XDG_STATE_HOME"] = str(tmp_path / "state")
+    exe = Path(sys.executable).with_name("qtanimator")
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "qtanimator"]
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, timeout=60, cwd=tmp_path)
+    assert proc.returncode == 2
+    assert proc.stderr.splitlines() == [NO_DISPLAY_LINE] and proc.stdout == ""
+    # --version and --help need no display.
+    assert subprocess.run([*cmd, "--version"], capture_output=True, text=True, env=env, timeout=60).returncode == 0
+
+
+@pytest.mark.parametrize("environ, platform, ok", [
+    ({}, "linux", False),
+    ({"DISPLAY": ":0"}, "linux", True),
+    ({"WAYLAND_DISPLAY": "wayland-0"}, "linux", True),
+    ({"QT_QPA_PLATFORM": "offscreen"}, "linux", True),
+    ({"QT_QPA_PLATFORM": "vnc:size=800x600"}, "linux", True),
+    ({"QT_QPA_PLATFORM": "wayland;xcb"}, "linux", False),
+    ({"QT_QPA_PLATFORM": "xcb", "DISPLAY": ""}, "linux", False),
+    ({"QT_QPA_PLATFORM": "minimal"}, "freebsd14", True),
+    ({}, "darwin", True),
+    ({}, "win32", True),
+])
+def test_display_detection(environ, platform, ok):
+    from qtanimator.cli import NO_DISPLAY, display_problem
+
+    assert display_problem(environ, platform) == (None if ok else NO_DISPLAY)
+
+
+def test_verbose_is_an_option(capsys):
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
+    assert "--verbose" in out and "log" in out

@@ -1,11 +1,20 @@
-"""Opening and saving documents as JSON projects."""
+"""Opening and saving documents as JSON projects.
+
+Opening a project whose asset files moved does not fail at once: :func:`open_document_relinked`
+looks for each missing file by name beside the project (its folder tree, the folders of
+files already found), then asks ``locate`` (the GUI shows a file dialog), and reports what
+it relinked. Only a file that is still missing after that makes the open fail.
+"""
 
 from __future__ import annotations
 
 import copy
 import os
+from collections.abc import Callable
+from dataclasses import dataclass, replace
 from pathlib import Path
 
+from qtanimator.document.asset_files import FileRef, find_beside, missing_refs
 from qtanimator.document.assets import load_runtime
 from qtanimator.document.document import PROJECT_DEFAULTS, Asset, Document
 from qtanimator.formats.errors import FormatError
@@ -48,11 +57,93 @@ def document_from_project_data(data: ProjectData) -> Document:
     return doc
 
 
-def open_document(path: str | os.PathLike[str]) -> Document:
+#: Asked for a missing file: returns the path the user picked, or None to give up.
+Locate = Callable[[FileRef], str | None]
+
+
+@dataclass(frozen=True)
+class Relink:
+    """A file reference found at a new place: ``how`` is ``"found"`` (by name beside the
+    project) or ``"chosen"`` (the user picked it)."""
+
+    ref: FileRef
+    new_path: str
+    how: str
+
+
+def open_document(path: str | os.PathLike[str], locate: Locate | None = None) -> Document:
     """Read a project into a new document; the caller's document is never touched."""
-    doc = document_from_project_data(load_project(path))
+    return open_document_relinked(path, locate)[0]
+
+
+def open_document_relinked(path: str | os.PathLike[str],
+                           locate: Locate | None = None) -> tuple[Document, list[Relink]]:
+    """:func:`open_document`, finding moved asset files first; returns the relinks made.
+
+    The document holds the new paths (save it to keep them). FormatError as before when a
+    file is still missing."""
+    data = load_project(path)
+    relinks = relink_missing(data, Path(path).resolve().parent, locate)
+    doc = document_from_project_data(data)
     doc.path = str(Path(path).resolve())
-    return doc
+    return doc, relinks
+
+
+def relink_missing(data: ProjectData, project_dir: Path, locate: Locate | None = None) -> list[Relink]:
+    """Point ``data``'s missing file references at files found or chosen by the user.
+
+    For each missing file, in this order: the same relative place under a folder that an
+    earlier missing file was found to have moved to (a whole folder moved: ``art/x.skel`` now
+    in ``backup/``, so ``art/other/y.skin`` is looked for as ``backup/other/y.skin``); a file
+    of the same name in the project's folder tree or those new folders; ``locate``.
+    """
+    relinks: list[Relink] = []
+    folders: list[Path] = [project_dir]
+    moves: list[tuple[Path, Path]] = []  # (old folder, new folder)
+    resolved: dict[str, str] = {}  # the same missing file referenced twice is asked for once
+    for ref in missing_refs(data.assets):
+        old = Path(ref.path)
+        new = resolved.get(ref.path)
+        how = "found"
+        if new is None:
+            found = _moved_along(old, moves) or find_beside(old.name, folders)
+            if found is not None:
+                new = str(found)
+            elif locate is not None:
+                chosen = locate(ref)
+                if chosen:
+                    new, how = str(Path(chosen).resolve()), "chosen"
+        if new is None or not Path(new).exists():
+            continue
+        if new not in resolved.values():
+            moves.append((old.parent, Path(new).parent))
+            if Path(new).parent not in folders:
+                folders.append(Path(new).parent)  # its neighbours moved along, most likely
+        resolved[ref.path] = new
+        _set_ref(data, ref, new)
+        relinks.append(Relink(ref, new, how))
+    return relinks
+
+
+def _moved_along(old: Path, moves: list[tuple[Path, Path]]) -> Path | None:
+    for old_dir, new_dir in moves:
+        try:
+            candidate = new_dir / old.relative_to(old_dir)
+        except ValueError:
+            continue
+        if candidate.exists():
+            return candidate.resolve()
+    return None
+
+
+def _set_ref(data: ProjectData, ref: FileRef, new_path: str) -> None:
+    for i, rec in enumerate(data.assets):
+        if rec.id != ref.asset_id:
+            continue
+        if ref.key == "source":
+            data.assets[i] = replace(rec, source=new_path)
+        else:
+            data.assets[i] = replace(rec, properties={**rec.properties, ref.key: new_path})
 
 
 def save_document(doc: Document, path: str | os.PathLike[str]) -> None:

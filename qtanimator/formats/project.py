@@ -30,6 +30,14 @@ a line. Version 1 wrote one object per key, ``"keys": [{"t": 0.0, "v": 0.5, "in"
 Asset ``source`` paths and asset properties whose name ends in ``_file`` are stored
 relative to the project file and made absolute on load. This module knows the schema only;
 :mod:`qtanimator.document.io` turns a :class:`ProjectData` into a live document and back.
+
+A path that leads out of the project folder is listed in the asset's ``"outside"`` (the
+keys: ``"source"`` or a property name), written only when there is one. Every path in a
+document is there by the user's choice (a file opened or dropped, a missing file located,
+Save As without Collect Assets), so the writer records those choices; the reader keeps the
+list (:attr:`AssetRecord.outside`) so that a reader confined to the project folder (issue 19)
+can allow exactly these and refuse any other path out of the folder. Older readers ignore
+the field, so it needs no new format version.
 """
 
 from __future__ import annotations
@@ -60,6 +68,10 @@ class AssetRecord:
     kind: str
     source: str | None = None  # absolute once loaded
     properties: dict[str, Any] = field(default_factory=dict)
+    #: The references (``"source"`` or ``*_file`` property names) the project recorded as
+    #: leading out of its folder by the user's choice (read from the file; the writer
+    #: computes it afresh).
+    outside: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -85,10 +97,17 @@ def project_json_parts(data: ProjectData, base_dir: str | os.PathLike[str]) -> I
     assets = []
     for a in data.assets:
         source = a.source
+        outside = []
         if source is not None:
             source = _relative(Path(source), base)
+            if _leaves(source):
+                outside.append("source")
         props = {k: (_relative(Path(v), base) if _is_path_key(k, v) else v) for k, v in a.properties.items()}
-        assets.append({"id": a.id, "kind": a.kind, "source": source, "properties": props})
+        outside += [k for k, v in props.items() if _is_path_key(k, v) and _leaves(v)]
+        record: dict[str, Any] = {"id": a.id, "kind": a.kind, "source": source, "properties": props}
+        if outside:
+            record["outside"] = outside
+        assets.append(record)
     yield "{\n"
     yield f'  "format": {_json(FORMAT_NAME, 1)},\n'
     yield f'  "version": {_json(FORMAT_VERSION, 1)},\n'
@@ -182,6 +201,11 @@ def _is_path_key(key: str, value: Any) -> bool:
     return key.endswith("_file") and isinstance(value, str) and bool(value)
 
 
+def _leaves(relative: str) -> bool:
+    """True for a stored path that leads out of the project folder."""
+    return relative == ".." or relative.startswith("../") or Path(relative).is_absolute()
+
+
 def _relative(path: Path, base: Path) -> str:
     try:
         return Path(os.path.relpath(path.resolve(), base)).as_posix()
@@ -258,9 +282,12 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
         props = a.get("properties", {})
         if not isinstance(props, dict):
             raise FormatError(f"asset {a['id']!r}: \"properties\" must be an object.", p)
+        outside = a.get("outside", [])
+        if not isinstance(outside, list) or not all(isinstance(k, str) for k in outside):
+            raise FormatError(f"asset {a['id']!r}: \"outside\" must be a list of names.", p)
         abs_source = _absolute(base, source, p) if source else None
         props = {k: (_absolute(base, v, p) if _is_path_key(k, v) else v) for k, v in props.items()}
-        data.assets.append(AssetRecord(a["id"], a["kind"], abs_source, props))
+        data.assets.append(AssetRecord(a["id"], a["kind"], abs_source, props, list(outside)))
     channels = obj.get("channels", {})
     if not isinstance(channels, dict):
         raise FormatError("\"channels\" must be an object.", p)

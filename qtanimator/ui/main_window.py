@@ -15,8 +15,10 @@ from pathlib import Path
 
 import shiboken6
 from PySide6.QtCore import QByteArray, QSettings, Qt
-from PySide6.QtGui import QAction, QCloseEvent, QDragEnterEvent, QDropEvent, QKeySequence
+from PySide6.QtGui import QAction, QCloseEvent, QDragEnterEvent, QDropEvent, QIcon, QKeySequence
 from PySide6.QtWidgets import (
+    QApplication,
+    QCheckBox,
     QDockWidget,
     QFileDialog,
     QMainWindow,
@@ -27,9 +29,12 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator import __version__
+from qtanimator.document.asset_files import ASSETS_FOLDER, FileRef, collect_assets, file_refs, is_inside
 from qtanimator.document.document import Document
-from qtanimator.document.io import open_document, save_document
+from qtanimator.document.io import Relink, open_document_relinked, save_document
 from qtanimator.formats.errors import FormatError
+from qtanimator.paths import app_icon_path
+from qtanimator.ui import errors, help_viewer
 from qtanimator.ui.context import EditorContext
 
 PROJECT_SUFFIX = ".qtanim"
@@ -70,7 +75,11 @@ class MainWindow(QMainWindow):
         short names of the editor modules to install (``{"timeline", "rig_editor"}``)."""
         super().__init__()
         self.setObjectName("mainWindow")
+        self.setWindowIcon(QIcon(str(app_icon_path())))
         self.ctx = EditorContext(doc, self)
+        #: Asset files found at new places when the project was opened: the document differs
+        #: from its file although the undo stack is clean (cleared by a save or another open).
+        self._relinked_unsaved = False
         self.openers: dict[str, Opener] = {}
         #: Called before the document is written (Save, Save As, autosave): editors put view
         #: state such as the 3D camera into the document here, without an undo step.
@@ -137,6 +146,9 @@ class MainWindow(QMainWindow):
         self.action_save = self._action("actionSave", "&Save", self.save, QKeySequence.StandardKey.Save)
         self.action_save_as = self._action("actionSaveAs", "Save &As…", self.save_as,
                                            QKeySequence.StandardKey.SaveAs)
+        self.action_collect = self._action("actionCollectAssets", "&Collect Assets…", self.collect_assets)
+        self.action_collect.setStatusTip("Copy every file the project uses into its folder, so that the folder "
+                                         "can be moved or shared")
         self.action_quit = self._action("actionQuit", "&Quit", self.close, QKeySequence.StandardKey.Quit)
         self.recent_menu = self.file_menu.addMenu("Open &Recent")
         self.recent_menu.setObjectName("menuRecent")
@@ -145,6 +157,7 @@ class MainWindow(QMainWindow):
         self.file_menu.addSeparator()
         self.file_menu.addAction(self.action_save)
         self.file_menu.addAction(self.action_save_as)
+        self.file_menu.addAction(self.action_collect)
         self.file_menu.addSeparator()
         self.export_separator = self.file_menu.addSeparator()
         self.file_menu.addAction(self.action_quit)
@@ -161,8 +174,17 @@ class MainWindow(QMainWindow):
         self.edit_menu.addAction(self.action_redo)
         self.edit_menu.addSeparator()
 
-        about = self._action("actionAbout", "&About qtanimator", self._about)
-        self.help_menu.addAction(about)
+        self.help_menu.addAction(self._action("actionUserGuide", "&User Guide", lambda: self.show_help("user-guide"),
+                                              QKeySequence.StandardKey.HelpContents))
+        self.help_menu.addAction(self._action("actionKeyboardReference", "&Keyboard Reference",
+                                              lambda: self.show_help("keyboard")))
+        self.help_menu.addSeparator()
+        report = self._action("actionReportProblem", "&Report a Problem…", self.report_problem)
+        report.setStatusTip("Open the folder of the log file, to attach it to a problem report")
+        self.help_menu.addAction(report)
+        self.help_menu.addSeparator()
+        self.help_menu.addAction(self._action("actionAbout", "&About qtanimator", self._about))
+        self.help_menu.addAction(self._action("actionAboutQt", "About &Qt", QApplication.aboutQt))
 
     def _build_undo_history(self) -> None:
         view = QUndoView(self.ctx.undo_stack)
@@ -174,7 +196,22 @@ class MainWindow(QMainWindow):
 
     def _about(self) -> None:
         QMessageBox.about(self, "About qtanimator",
-                          f"qtanimator {__version__}\nCharacter animation: 2D rigs, curves, 3D and cloth.")
+                          f"qtanimator {__version__}\nCharacter animation: 2D rigs, curves, 3D and cloth.\n"
+                          "MIT licence, by the qtanimator contributors.")
+
+    def show_help(self, page: str) -> None:
+        """Help ▸ User Guide / Keyboard Reference: the page shipped with the package."""
+        if help_viewer.open_help(self, page) is None:
+            self.show_error("Help not installed", f"{help_viewer.page_path(page)} is missing from this "
+                            "installation.")
+
+    def report_problem(self) -> None:
+        """Help ▸ Report a Problem: open the log folder (the log says what went wrong)."""
+        from qtanimator import applog
+
+        if not errors.open_log_folder():
+            QMessageBox.information(self, "Report a Problem",
+                                    f"Attach the log file to your report:\n{applog.log_path()}")
 
     # ---------------------------------------------------------------- errors
     def show_error(self, title: str, text: str) -> None:
@@ -183,7 +220,7 @@ class MainWindow(QMainWindow):
 
     # ----------------------------------------------------------------- files
     def is_modified(self) -> bool:
-        return not self.ctx.undo_stack.isClean()
+        return self._relinked_unsaved or not self.ctx.undo_stack.isClean()
 
     def maybe_save(self) -> bool:
         """Ask about unsaved changes. Returns False if the user cancels."""
@@ -199,6 +236,7 @@ class MainWindow(QMainWindow):
 
     def new_document(self) -> None:
         if self.maybe_save():
+            self._relinked_unsaved = False
             self.ctx.replace_document(Document())
 
     def replaces_document(self, path: str | os.PathLike[str]) -> bool:
@@ -232,7 +270,11 @@ class MainWindow(QMainWindow):
             if opener is not None:
                 opener(self, p)
             elif p.suffix.lower() in (PROJECT_SUFFIX, ".json"):
-                self.ctx.replace_document(open_document(p))
+                doc, relinks = open_document_relinked(p, self.locate_missing_file)
+                self._relinked_unsaved = bool(relinks)
+                self.ctx.replace_document(doc)
+                if relinks:
+                    self._tell_relinked(relinks)
             else:
                 raise FormatError("qtanimator does not know this kind of file.", p)
         except FormatError as exc:
@@ -253,30 +295,127 @@ class MainWindow(QMainWindow):
         return self.save_to(self.doc.path)
 
     def save_as(self) -> bool:
+        """Ask where (and whether to collect the assets there), then save."""
         start = self.doc.path or str(Path(self._last_dir()) / f"untitled{PROJECT_SUFFIX}")
-        path, _ = QFileDialog.getSaveFileName(self, "Save Project", start, PROJECT_FILTER)
+        path, collect = self.ask_save_path(start)
         if not path:
             return False
         if not Path(path).suffix:
             path += PROJECT_SUFFIX
-        return self.save_to(path)
+        settings().setValue("collectAssets", collect)
+        return self.save_to(path, collect=collect)
+
+    def ask_save_path(self, start: str) -> tuple[str, bool]:
+        """The Save As dialog: a path ("" when cancelled) and the state of its "Copy the
+        assets into the project folder" box (remembered from the last Save As)."""
+        dialog = QFileDialog(self, "Save Project", start, PROJECT_FILTER)
+        dialog.setObjectName("saveAsDialog")
+        dialog.setAcceptMode(QFileDialog.AcceptMode.AcceptSave)
+        dialog.setDefaultSuffix(PROJECT_SUFFIX.lstrip("."))
+        dialog.setOption(QFileDialog.Option.DontUseNativeDialog)  # a native dialog takes no extra widget
+        dialog.selectFile(start)
+        box = QCheckBox(f"Collect assets: copy every file the project uses into its {ASSETS_FOLDER}/ folder")
+        box.setObjectName("collectAssetsCheck")
+        box.setToolTip("The project folder then holds everything: it can be moved, zipped or shared.")
+        box.setChecked(bool(settings().value("collectAssets", False, type=bool)))
+        layout = dialog.layout()
+        if layout is not None:
+            layout.addWidget(box)
+        if not dialog.exec():
+            return "", False
+        files = dialog.selectedFiles()
+        return (files[0] if files else ""), box.isChecked()
 
     def prepare_save(self) -> None:
         """Let the editors store their view state in the document (see ``save_hooks``)."""
         for hook in self.save_hooks:
             hook()
 
-    def save_to(self, path: str | os.PathLike[str]) -> bool:
+    def save_to(self, path: str | os.PathLike[str], collect: bool = False) -> bool:
+        """Save to ``path``, making its folder when it does not exist; with ``collect``, copy
+        the assets into that folder first (one undo step, Collect Assets). A failure shows
+        a sentence naming ``path`` and leaves the document as it was."""
+        target = Path(path).absolute()
+        try:
+            target.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            self.show_error("Cannot save", f"Cannot make the folder {target.parent} for {target.name}: "
+                            f"{exc.strerror or exc}.")
+            return False
+        if collect and not self._collect_into(target.parent):
+            return False
         try:
             self.prepare_save()
-            save_document(self.doc, path)
-        except (OSError, ValueError) as exc:
-            self.show_error("Cannot save", f"{Path(path).name}: {exc}")
+            save_document(self.doc, target)
+        except OSError as exc:
+            # The error names the temporary file the save wrote first: name the target instead.
+            self.show_error("Cannot save", f"Cannot save {target}: {exc.strerror or exc}.")
+            return False
+        except ValueError as exc:
+            self.show_error("Cannot save", f"Cannot save {target}: {exc}")
             return False
         self.ctx.undo_stack.setClean()
-        self._remember_recent(Path(path))
+        self._relinked_unsaved = False
+        self._remember_recent(target)
         self._update_title()
         return True
+
+    # --------------------------------------------------------------- assets
+    def collect_assets(self) -> bool:
+        """File ▸ Collect Assets: copy the files the project uses into its folder's
+        ``assets/`` and point the project at the copies (one undo step). An untitled
+        project is saved first (Save As, with collecting ticked)."""
+        if self.doc.path is None:
+            start = str(Path(self._last_dir()) / f"untitled{PROJECT_SUFFIX}")
+            path, _collect = self.ask_save_path(start)
+            if not path:
+                return False
+            if not Path(path).suffix:
+                path += PROJECT_SUFFIX
+            return self.save_to(path, collect=True)
+        folder = Path(self.doc.path).parent
+        outside = [r for r in file_refs(self.doc.assets.values()) if not is_inside(r.path, folder)]
+        if not outside:
+            QMessageBox.information(self, "Collect Assets",
+                                    f"Every file the project uses is already in {folder}.")
+            return True
+        return self._collect_into(folder)
+
+    def _collect_into(self, folder: Path) -> bool:
+        try:
+            result = collect_assets(self.doc, folder)
+        except OSError as exc:
+            where = f" ({exc.filename})" if exc.filename else ""
+            self.show_error("Cannot collect assets", f"Copying into {folder / ASSETS_FOLDER} failed{where}: "
+                            f"{exc.strerror or exc}. The project still uses the files where they were.")
+            return False
+        if result.command is not None:
+            self.ctx.push(result.command)
+        missing = [r for r in file_refs(self.doc.assets.values()) if not Path(r.path).exists()]
+        if missing:
+            names = ", ".join(sorted({Path(r.path).name for r in missing}))
+            QMessageBox.warning(self, "Collect Assets", f"These files are missing and were not copied: {names}.")
+        return True
+
+    def locate_missing_file(self, ref: FileRef) -> str | None:
+        """Asked while opening a project whose file ``ref`` is not where it was and not found
+        beside the project: a file dialog to point at it (None when cancelled)."""
+        old = Path(ref.path)
+        title = f"Locate {old.name} (missing, used by {ref.asset_id})"
+        start = self._last_dir()
+        if not old.suffix:  # a folder of SVG characters
+            chosen = QFileDialog.getExistingDirectory(self, title, start)
+        else:
+            chosen, _ = QFileDialog.getOpenFileName(self, title, start, f"{old.name} (*{old.suffix});;All files (*)")
+        return chosen or None
+
+    def _tell_relinked(self, relinks: list[Relink]) -> None:
+        lines = [f"{r.ref.asset_id}: {Path(r.ref.path).name} → {r.new_path}"
+                 + ("" if r.how == "chosen" else " (found beside the project)") for r in relinks]
+        QMessageBox.information(
+            self, "Assets found at new places",
+            "Some files of this project had moved; it now uses:\n\n" + "\n".join(lines)
+            + "\n\nSave the project to keep these locations.")
 
     def _last_dir(self) -> str:
         return str(settings().value("lastDir", str(Path.home())))

@@ -1,5 +1,9 @@
 from __future__ import annotations
 
+import os
+import shutil
+from pathlib import Path
+
 import pytest
 
 from qtanimator.core.channel import Key
@@ -126,13 +130,76 @@ def test_opening_a_bad_file_shows_the_error_and_changes_nothing(qtbot, tmp_path,
     assert str(bad.resolve()) not in window.recent_files()
 
 
-def test_saving_to_an_impossible_place_shows_an_error(qtbot, tmp_path, dialog_log):
+def test_saving_to_an_impossible_place_names_the_target_not_the_temporary_file(qtbot, tmp_path, dialog_log,
+                                                                              monkeypatch):
     window = MainWindow(install_editors=False)
     qtbot.addWidget(window)
     window.ctx.push(InsertKey(window.doc, "hero//x", Key(0.5, 3.0)))
-    assert not window.save_to(tmp_path / "no" / "such" / "folder" / "x.qtanim")
-    assert dialog_log[-1][0] == "Cannot save"
+    blocker = tmp_path / "a_file.txt"
+    blocker.write_text("not a folder")
+    target = blocker / "inside" / "x.qtanim"  # a folder cannot be made inside a file
+    assert not window.save_to(target)
+    title, text = dialog_log[-1]
+    assert title == "Cannot save"
+    assert str(target.parent) in text and ".tmp" not in text
     assert window.isWindowModified()
+    # A read-only folder (root may write anyway): the message names the project file, never
+    # the temporary one.
+    locked = tmp_path / "locked"
+    locked.mkdir()
+    locked.chmod(0o555)
+    try:
+        if not os.access(locked, os.W_OK):
+            assert not window.save_to(locked / "x.qtanim")
+            assert str(locked / "x.qtanim") in dialog_log[-1][1] and ".tmp" not in dialog_log[-1][1]
+    finally:
+        locked.chmod(0o755)
+    # Whatever the operating system's error names (the temporary file), the dialog names the target.
+    import errno
+
+    import qtanimator.ui.main_window as main_window
+
+    def failing_save(doc, path):  # type: ignore[no-untyped-def]
+        raise PermissionError(errno.EACCES, "Permission denied", str(Path(path).parent / ".x.qtanim.f8svxrjl.tmp"))
+
+    monkeypatch.setattr(main_window, "save_document", failing_save)
+    assert not window.save_to(tmp_path / "x.qtanim")
+    assert dialog_log[-1][1] == f"Cannot save {tmp_path / 'x.qtanim'}: Permission denied."
+
+
+def test_save_as_into_a_folder_that_does_not_exist_creates_it(qtbot, tmp_path, monkeypatch, dialog_log):
+    window = MainWindow(install_editors=False)
+    qtbot.addWidget(window)
+    window.ctx.push(InsertKey(window.doc, "hero//x", Key(0.5, 3.0)))
+    target = tmp_path / "new" / "deeper" / "myproj"  # no suffix typed: .qtanim is added
+    monkeypatch.setattr(window, "ask_save_path", lambda start: (str(target), False))
+    assert window.save_as()
+    saved = target.with_suffix(".qtanim")
+    assert saved.is_file() and not dialog_log
+    assert not window.isWindowModified() and window.doc.path == str(saved.resolve())
+    assert [p.name for p in saved.parent.iterdir()] == ["myproj.qtanim"]  # no temporary file left
+
+
+def test_save_as_dialog_offers_to_collect_the_assets(qtbot, tmp_path):
+    from PySide6.QtWidgets import QCheckBox, QFileDialog
+
+    window = MainWindow(install_editors=False)
+    qtbot.addWidget(window)
+    seen: list[tuple[bool, str]] = []
+
+    def fake_exec(dialog: QFileDialog) -> int:
+        box = dialog.findChild(QCheckBox, "collectAssetsCheck")
+        seen.append((box is not None and box.isVisibleTo(dialog), dialog.windowTitle()))
+        box.setChecked(True)
+        dialog.selectFile(str(tmp_path / "p.qtanim"))
+        return 1
+
+    import unittest.mock as mock
+
+    with mock.patch.object(QFileDialog, "exec", fake_exec):
+        path, collect = window.ask_save_path(str(tmp_path / "untitled.qtanim"))
+    assert seen == [(True, "Save Project")]
+    assert Path(path).name == "p.qtanim" and collect
 
 
 def test_recent_files_menu(qtbot, tmp_path):
@@ -259,3 +326,189 @@ def test_editor_context_signals(qtbot):
     assert resets == [True] and ctx.frame == 10.0 and ctx.selection == ("", "")
     assert ctx.undo_stack.count() == 0 and ctx.undo_stack.isClean()
     assert channel_sel[-1] == [] and ctx.channel_selection == []
+
+
+# ---------------------------------------------------------------------- help menu
+def test_help_menu_shows_the_installed_guides_and_opens_the_log_folder(qtbot, monkeypatch, tmp_path):
+    from PySide6.QtGui import QAction, QDesktopServices
+    from PySide6.QtWidgets import QTextBrowser
+
+    from qtanimator import paths
+
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path / "state"))
+    window = MainWindow(install_editors=False)
+    qtbot.addWidget(window)
+    names = [a.objectName() for a in window.help_menu.actions()]
+    for name in ("actionUserGuide", "actionKeyboardReference", "actionReportProblem", "actionAbout",
+                 "actionAboutQt"):
+        assert name in names
+    assert not window.windowIcon().isNull()
+    window.findChild(QAction, "actionUserGuide").trigger()
+    browser = window.findChild(QTextBrowser, "helpBrowser")
+    assert browser is not None and browser.isVisible()
+    assert browser.source().toLocalFile() == str(paths.docs_dir() / "user-guide.md")
+    assert "user guide" in browser.toPlainText().lower()
+    window.findChild(QAction, "actionKeyboardReference").trigger()
+    viewers = [b.source().toLocalFile() for b in window.findChildren(QTextBrowser, "helpBrowser")]
+    assert str(paths.docs_dir() / "keyboard.md") in viewers
+    # A link to another page opens it in the same viewer.
+    from PySide6.QtCore import QUrl
+
+    browser.anchorClicked.emit(QUrl("formats.md"))
+    assert browser.source().toLocalFile() == str(paths.docs_dir() / "formats.md")
+    opened: list[str] = []
+    monkeypatch.setattr(QDesktopServices, "openUrl", staticmethod(lambda url: opened.append(url.toLocalFile())
+                                                                  or True))
+    window.findChild(QAction, "actionReportProblem").trigger()
+    assert opened == [str(tmp_path / "state" / "qtanimator")]
+    assert (tmp_path / "state" / "qtanimator").is_dir()
+
+
+# ---------------------------------------------------------------------- projects that travel
+FLAPPY = Path(__file__).resolve().parents[2] / "scenes" / "flappy.svg"
+
+
+def _window_with_character(qtbot, svg: Path) -> MainWindow:
+    from qtanimator.document.character2d import add_characters_command
+
+    window = MainWindow(install_editors=False)
+    qtbot.addWidget(window)
+    window.ctx.push(add_characters_command(window.doc, svg))
+    window.ctx.push(InsertKey(window.doc, "hero//x", Key(0.5, 3.0)))
+    return window
+
+
+def test_collect_assets_then_moving_the_project_folder_still_opens(qtbot, tmp_path, monkeypatch, dialog_log):
+    from PySide6.QtGui import QAction
+
+    from qtanimator.document import open_document
+
+    elsewhere = tmp_path / "downloads"
+    elsewhere.mkdir()
+    svg = elsewhere / "flappy.svg"
+    shutil.copy(FLAPPY, svg)
+    window = _window_with_character(qtbot, svg)
+    (asset_id,) = [a.id for a in window.doc.assets.values() if a.source]
+    state = window.doc.state()
+    project = tmp_path / "work" / "bird" / "bird.qtanim"
+    monkeypatch.setattr(window, "ask_save_path", lambda start: (str(project), True))
+    assert window.save_as()  # Save As with "collect assets" ticked, into a new folder
+    collected = project.parent / "assets" / "flappy.svg"
+    assert collected.read_bytes() == svg.read_bytes()
+    assert window.doc.assets[asset_id].source == str(collected.resolve())
+    assert window.ctx.undo_stack.text(window.ctx.undo_stack.count() - 1) == "Collect Assets"
+    assert not window.isWindowModified() and not dialog_log
+    # Move the whole project folder and delete the original SVG: the project still opens.
+    moved = shutil.move(str(project.parent), str(tmp_path / "usb" / "bird"))
+    svg.unlink()
+    doc = open_document(Path(moved) / "bird.qtanim")
+    assert doc.assets[asset_id].source == str((Path(moved) / "assets" / "flappy.svg").resolve())
+    assert asset_id in doc.runtime
+    assert doc.state()["channels"] == state["channels"]
+    # The file stores a relative path, and nothing outside the folder.
+    text = (Path(moved) / "bird.qtanim").read_text()
+    assert '"source": "assets/flappy.svg"' in text and '"outside"' not in text
+    # File > Collect Assets on a project that already travels copies nothing.
+    window2 = MainWindow(install_editors=False)
+    qtbot.addWidget(window2)
+    assert window2.open_path(Path(moved) / "bird.qtanim")
+    window2.findChild(QAction, "actionCollectAssets").trigger()
+    assert dialog_log[-1][0] == "Collect Assets" and "already" in dialog_log[-1][1]
+    assert window2.ctx.undo_stack.count() == 0
+
+
+def test_collect_assets_is_one_undoable_step(qtbot, tmp_path, dialog_log):
+    from PySide6.QtGui import QAction
+
+    from qtanimator.document import save_document
+
+    elsewhere = tmp_path / "art"
+    elsewhere.mkdir()
+    shutil.copy(FLAPPY, elsewhere / "flappy.svg")
+    window = _window_with_character(qtbot, elsewhere / "flappy.svg")
+    project = tmp_path / "proj" / "p.qtanim"
+    project.parent.mkdir()
+    assert window.save_to(project)
+    assert '"outside": [' in project.read_text()  # recorded: the user chose a file elsewhere
+    before = window.doc.state()
+    steps = window.ctx.undo_stack.count()
+    window.findChild(QAction, "actionCollectAssets").trigger()
+    assert window.ctx.undo_stack.count() == steps + 1 and window.isWindowModified()
+    sources = [a.source for a in window.doc.assets.values() if a.source]
+    assert sources and all(Path(s).parent == (project.parent / "assets").resolve() for s in sources)
+    window.action_undo.trigger()
+    assert window.doc.state() == before
+    window.action_redo.trigger()
+    save_document(window.doc, project)
+    assert '"outside"' not in project.read_text()
+
+
+def test_a_missing_asset_is_found_beside_the_project(qtbot, tmp_path, monkeypatch, dialog_log):
+    from PySide6.QtWidgets import QFileDialog
+
+    from qtanimator.document import save_document
+
+    svg = tmp_path / "old place" / "flappy.svg"
+    svg.parent.mkdir()
+    shutil.copy(FLAPPY, svg)
+    window = _window_with_character(qtbot, svg)
+    project = tmp_path / "proj" / "p.qtanim"
+    project.parent.mkdir()
+    save_document(window.doc, project)
+    (project.parent / "art").mkdir()
+    shutil.move(str(svg), str(project.parent / "art" / "flappy.svg"))  # the user tidied up
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: pytest.fail("asked")))
+    other = MainWindow(install_editors=False)
+    qtbot.addWidget(other)
+    assert other.open_path(project)
+    (source,) = [a.source for a in other.doc.assets.values() if a.source]
+    assert source == str((project.parent / "art" / "flappy.svg").resolve())
+    assert dialog_log[-1][0] == "Assets found at new places" and "flappy.svg" in dialog_log[-1][1]
+    assert other.isWindowModified()  # save to keep the new place
+    assert other.save_to(project) and not other.isWindowModified()
+    assert '"source": "art/flappy.svg"' in project.read_text()
+
+
+def test_a_missing_asset_is_relinked_with_the_file_dialog(qtbot, tmp_path, monkeypatch, dialog_log):
+    from PySide6.QtWidgets import QFileDialog
+
+    from qtanimator.document import save_document
+
+    svg = tmp_path / "old" / "flappy.svg"
+    svg.parent.mkdir()
+    shutil.copy(FLAPPY, svg)
+    window = _window_with_character(qtbot, svg)
+    project = tmp_path / "proj" / "p.qtanim"
+    project.parent.mkdir()
+    save_document(window.doc, project)
+    state = window.doc.state()
+    new_home = tmp_path / "elsewhere" / "renamed_bird.svg"
+    new_home.parent.mkdir()
+    shutil.move(str(svg), str(new_home))
+    asked: list[str] = []
+
+    def pick(_parent, title, *args, **kwargs):  # type: ignore[no-untyped-def]
+        asked.append(title)
+        return str(new_home), ""
+
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(pick))
+    other = MainWindow(install_editors=False)
+    qtbot.addWidget(other)
+    assert other.open_path(project)
+    assert len(asked) == 1 and "flappy.svg" in asked[0] and "missing" in asked[0]
+    (asset,) = [a for a in other.doc.assets.values() if a.source]
+    assert asset.source == str(new_home.resolve()) and asset.id in other.doc.runtime
+    assert other.doc.state()["channels"] == state["channels"]
+    assert "renamed_bird.svg" in dialog_log[-1][1] and other.isWindowModified()
+    assert other.save_to(project)
+    text = project.read_text()
+    assert "../elsewhere/renamed_bird.svg" in text and '"outside": [' in text  # the user's choice, recorded
+    # Cancelling the dialog: the open fails with the reader's sentence and changes nothing.
+    new_home.unlink()
+    monkeypatch.setattr(QFileDialog, "getOpenFileName", staticmethod(lambda *a, **k: ("", "")))
+    third = MainWindow(install_editors=False)
+    qtbot.addWidget(third)
+    before = third.doc.state()
+    assert not third.open_path(project)
+    assert dialog_log[-1][0] == "Cannot open file" and "renamed_bird.svg" in dialog_log[-1][1]
+    assert third.doc.state() == before
