@@ -584,7 +584,8 @@ class _Reader:
         if sparse is not None:
             raw = self.apply_sparse(raw, self.obj(sparse, f"{aw}.sparse"), aw, dtype_code, count, cols, rows)
         if ctype == FLOAT:
-            out: npt.NDArray[Any] = raw.astype(np.float64)
+            with np.errstate(invalid="ignore"):  # a signalling NaN warns when cast; refused below
+                out: npt.NDArray[Any] = raw.astype(np.float64)
             if not np.isfinite(out).all():
                 raise self.error(f"{aw} holds values that are not finite numbers.")
         elif normalized:
