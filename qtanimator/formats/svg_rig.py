@@ -10,6 +10,11 @@ Unlike the reference program this reader takes full SVG through svgelements: cur
 (flattened), transforms on groups and shapes (baked into the geometry), inherited styles,
 named and 3-digit colours, opacity. A joint whose last element is not a circle uses that
 element's bounding-box centre, with a warning in ``Character.warnings`` and the log.
+
+Before svgelements sees a file, :mod:`qtanimator.formats._svg_budget` measures it as
+svgelements would expand it (``<use>`` copies, inherited transforms, path points…) and
+refuses what is beyond the limits of :mod:`qtanimator.formats.limits`; flattening curves
+stops at ``MAX_FLATTENED_POINTS``.
 """
 
 from __future__ import annotations
@@ -26,6 +31,8 @@ import numpy as np
 import svgelements as se
 
 from qtanimator.core.rig2d import RGBA, Character, Joint, Shape
+from qtanimator.formats import limits
+from qtanimator.formats._svg_budget import check_budget
 from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.errors import FormatError
 
@@ -61,6 +68,14 @@ def parse_character(data: bytes, name: str, path: str | os.PathLike[str] | None 
     if len(data) > _MAX_FILE_BYTES:
         raise FormatError("the file is too large for an SVG character.", path)
     try:
+        check_budget(data, path)
+    except FormatError:
+        raise
+    except RecursionError:
+        raise FormatError("the groups are nested too deeply.", path) from None
+    except Exception as exc:  # noqa: BLE001 - nothing else may escape a reader
+        raise FormatError(f"this is not a readable XML file ({type(exc).__name__}).", path) from None
+    try:
         root = ET.fromstring(data)
     except ET.ParseError as exc:
         line, col = getattr(exc, "position", (None, None))
@@ -71,7 +86,7 @@ def parse_character(data: bytes, name: str, path: str | os.PathLike[str] | None 
     if not isinstance(root.tag, str) or root.tag.rsplit("}", 1)[-1] != "svg":
         raise FormatError(f"the root element is <{root.tag}>, not <svg>.", path)
     try:
-        svg = se.SVG.parse(io.BytesIO(data), reify=False)
+        svg = se.SVG.parse(_WholeRead(data), reify=False)
     except Exception as exc:  # noqa: BLE001
         raise FormatError(f"the SVG could not be read ({type(exc).__name__}: {exc}).", path) from None
     builder = _Builder(path)
@@ -140,6 +155,18 @@ def summarize(path: str | os.PathLike[str]) -> dict[str, Any]:
 
 
 # ---------------------------------------------------------------------- helpers
+class _WholeRead(io.BytesIO):
+    """Hands svgelements' ``iterparse`` the whole document in one read.
+
+    ``iterparse`` feeds expat 16 KB at a time, and expat (before 2.6) scans a token that
+    spans many feeds again on every feed: a 60 MB attribute then takes hours. One feed
+    keeps parsing linear.
+    """
+
+    def read(self, size: int | None = -1, /) -> bytes:
+        return super().read(-1)
+
+
 def _xml_reason(exc: ET.ParseError) -> str:
     text = str(exc)
     return text.split(":")[0] if ":" in text else text
@@ -212,6 +239,15 @@ class _Builder:
         self.joints: list[Joint] = []
         self.warnings: list[str] = []
         self._names: set[str] = set()
+        self.points = 0  # flattened points so far, against MAX_FLATTENED_POINTS
+
+    def spend(self, n: int) -> None:
+        """Count ``n`` more flattened points; FormatError beyond the limit."""
+        self.points += n
+        if self.points > limits.MAX_FLATTENED_POINTS:
+            err = limits.exceeded(f"the number of points after curves are flattened ({self.points:,}+)",
+                                  f"{limits.MAX_FLATTENED_POINTS:,} (MAX_FLATTENED_POINTS)", self.path)
+            raise err
 
     def _name(self, *candidates: str | None) -> str:
         base = next((c for c in candidates if c), None)
@@ -302,6 +338,7 @@ class _Builder:
                 return []
             c = _apply(m, centre[None, :])[0]
             axes = m[:2, :2] @ np.diag([rx, ry])
+            self.spend(_ELLIPSE_SEGMENTS)
             t = np.linspace(0.0, 2 * math.pi, _ELLIPSE_SEGMENTS, endpoint=False)
             pts = c + np.stack([np.cos(t), np.sin(t)], axis=1) @ axes.T
             return [_checked(Shape(pts, True, kind="ellipse", ellipse=(c, axes), **style), self.path)]
@@ -310,7 +347,7 @@ class _Builder:
             w, h = _float(el.width), _float(el.height)
             rx, ry = _float(getattr(el, "rx", 0.0)), _float(getattr(el, "ry", 0.0))
             if (rx > 0 or ry > 0) and w > 0 and h > 0:
-                return [_checked(s, self.path) for s in _path_shapes(el, style)]
+                return [_checked(s, self.path) for s in _path_shapes(el, style, self)]
             if w == 0 and h == 0:
                 pts = _apply(m, np.array([[x, y]]))
                 return [_checked(Shape(pts, False, kind="point", **style), self.path)]
@@ -320,13 +357,14 @@ class _Builder:
             pts = np.array([[_float(el.x1), _float(el.y1)], [_float(el.x2), _float(el.y2)]])
             return [_checked(Shape(_apply(m, pts), False, kind="line", **style), self.path)]
         if isinstance(el, (se.Polygon, se.Polyline)):
+            self.spend(len(el.points))
             pts = np.array([[_float(p.x), _float(p.y)] for p in el.points], dtype=np.float64).reshape(-1, 2)
             if len(pts) == 0:
                 return []
             closed = isinstance(el, se.Polygon)
             return [_checked(Shape(_apply(m, pts), closed, kind="polygon" if closed else "polyline",
                                    **style), self.path)]
-        return [_checked(s, self.path) for s in _path_shapes(el, style)]
+        return [_checked(s, self.path) for s in _path_shapes(el, style, self)]
 
 
 def _checked(shape: Shape, path: str | os.PathLike[str] | None) -> Shape:
@@ -335,8 +373,12 @@ def _checked(shape: Shape, path: str | os.PathLike[str] | None) -> Shape:
     return shape
 
 
-def _path_shapes(el: Any, style: dict[str, Any]) -> list[Shape]:
-    """Flatten a path (or any other shape) into one Shape per subpath."""
+def _path_shapes(el: Any, style: dict[str, Any], budget: _Builder) -> list[Shape]:
+    """Flatten a path (or any other shape) into one Shape per subpath.
+
+    Curves are sampled with svgelements' vectorised ``npoint`` (``point`` calls it with one
+    position, so the points are the same) and counted against MAX_FLATTENED_POINTS.
+    """
     out: list[Shape] = []
     current: list[tuple[float, float]] = []
     closed = False
@@ -353,6 +395,7 @@ def _path_shapes(el: Any, style: dict[str, Any]) -> list[Shape]:
         closed = False
 
     for seg in el.segments(transformed=True):
+        budget.spend(1)
         if isinstance(seg, se.Move):
             flush()
             if seg.end is not None:
@@ -367,9 +410,9 @@ def _path_shapes(el: Any, style: dict[str, Any]) -> list[Shape]:
             if not current and seg.start is not None:
                 current.append((float(seg.start.x), float(seg.start.y)))
             n = _samples(seg)
-            for t in np.linspace(0.0, 1.0, n + 1)[1:]:
-                p = seg.point(float(t))
-                current.append((float(p.x), float(p.y)))
+            budget.spend(n)
+            xy = np.asarray(seg.npoint(np.linspace(0.0, 1.0, n + 1)[1:]), dtype=np.float64).reshape(n, 2)
+            current.extend((x, y) for x, y in xy.tolist())
     flush()
     return out
 
