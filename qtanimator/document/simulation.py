@@ -36,6 +36,36 @@ Job = Callable[[Callable[[], bool]], bool]
 
 _WORKERS: weakref.WeakSet[SimulationWorker] = weakref.WeakSet()
 
+#: Set while no gesture is in progress. While the user drags, every worker waits between
+#: frames: each mouse move invalidates what it would compute, and Python threads share one
+#: interpreter lock, so a worker busy during a drag takes half the UI thread's time. The
+#: simulation catches up when the gesture ends.
+_RESUMED = threading.Event()
+_RESUMED.set()
+_PAUSES = 0
+_PAUSE_LOCK = threading.Lock()
+
+
+def pause_workers() -> None:
+    """Hold every worker between frames until :func:`resume_workers` (nested calls count)."""
+    global _PAUSES
+    with _PAUSE_LOCK:
+        _PAUSES += 1
+        _RESUMED.clear()
+
+
+def resume_workers() -> None:
+    """Undo one :func:`pause_workers`; the workers go on when none is left."""
+    global _PAUSES
+    with _PAUSE_LOCK:
+        _PAUSES = max(_PAUSES - 1, 0)
+        if _PAUSES == 0:
+            _RESUMED.set()
+
+
+def workers_paused() -> bool:
+    return not _RESUMED.is_set()
+
 
 class SimulationCache(Protocol):
     """What the UI polls on every cache in ``doc.caches``."""
@@ -135,6 +165,11 @@ class SimulationWorker:
 
             try:
                 while not should_stop():
+                    while not _RESUMED.wait(0.05):  # a gesture is in progress
+                        if should_stop():
+                            break
+                    if should_stop():
+                        break
                     job = self._job()
                     if job is None:  # the cache (its document) is gone
                         stop.set()

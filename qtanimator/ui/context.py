@@ -19,7 +19,7 @@ from PySide6.QtGui import QUndoStack
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, DocumentChange
 from qtanimator.document.gesture import Gesture
-from qtanimator.document.simulation import ensure_caches, stop_simulations
+from qtanimator.document.simulation import ensure_caches, pause_workers, resume_workers, stop_simulations
 from qtanimator.document.simulation import progress as simulation_progress
 from qtanimator.ui.undo import push_command, record_command
 
@@ -128,6 +128,7 @@ class EditorContext(QObject):
         While any gesture is active, views refresh at most once per frame."""
         gesture = Gesture(self.doc, text, self._record, on_end=self._gesture_ended)
         self._gestures.append(gesture)
+        pause_workers()  # the drag gets the interpreter; simulations catch up at its end
         return gesture
 
     @property
@@ -140,6 +141,7 @@ class EditorContext(QObject):
     def _gesture_ended(self, gesture: Gesture) -> None:
         if gesture in self._gestures:
             self._gestures.remove(gesture)
+            resume_workers()
         if not self._gestures:
             self.flush_changes()
 

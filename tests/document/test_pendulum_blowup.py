@@ -60,3 +60,28 @@ def test_the_worker_stops_too_and_reports(clock):
     assert sim.wait_idle(30.0)
     assert sim.problem(asset) is not None
     assert sim.cached_frames(asset) < 150
+
+
+def test_workers_wait_while_a_gesture_is_in_progress(clock):
+    """pause_workers (the editor context calls it while a drag is in progress) holds every
+    worker between frames; resume_workers lets it catch up."""
+    import threading
+    import time
+
+    from qtanimator.document.simulation import pause_workers, resume_workers, workers_paused
+
+    doc, _stack, asset = clock
+    sim = c2d.simulation(doc)
+    pause_workers()
+    try:
+        assert workers_paused()
+        sim.latest_state(asset, 120)  # a view asks for frame 120: the worker is woken ...
+        deadline = time.monotonic() + 0.5
+        while time.monotonic() < deadline:  # ... but steps nothing while paused
+            assert sim.cached_frames(asset) <= 1, "a paused worker simulated frames"
+            threading.Event().wait(0.02)
+    finally:
+        resume_workers()
+    assert not workers_paused()
+    assert sim.wait_idle(30.0)
+    assert sim.cached_frames(asset) >= 121
