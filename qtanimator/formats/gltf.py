@@ -45,7 +45,14 @@ from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.atomic import write_atomic
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.glb import build_glb, is_glb, parse_json_text, read_glb
-from qtanimator.formats.limits import MAX_JOINTS, MAX_NODES, MAX_VERTICES, decoded_budget, exceeded
+from qtanimator.formats.limits import (
+    MAX_DATA_URI_BYTES,
+    MAX_JOINTS,
+    MAX_NODES,
+    MAX_VERTICES,
+    decoded_budget,
+    exceeded,
+)
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -662,6 +669,9 @@ def _read_uri(uri: str, base: Path | None, where: str, path: str | None) -> byte
         head, sep, payload = uri.partition(",")
         if not sep or not head.endswith(";base64"):
             raise FormatError(f"{where}.uri is a data URI that is not base64 encoded.", path)
+        if len(payload) // 4 * 3 > MAX_DATA_URI_BYTES:
+            raise exceeded(f"{where}.uri, a data URI of {len(payload) // 4 * 3:,} bytes",
+                           f"{MAX_DATA_URI_BYTES:,} bytes (MAX_DATA_URI_BYTES)", path)
         try:
             return base64.b64decode(payload, validate=True)
         except (binascii.Error, ValueError) as exc:

@@ -21,6 +21,9 @@ MAX_VERTICES = 10_000_000
 MAX_JOINTS = 10_000
 #: Nodes of one glTF scene.
 MAX_NODES = 100_000
+#: Bytes one base64 ``data:`` URI of a glTF may decode to (bigger buffers belong in a
+#: ``.bin`` file or a ``.glb``, which are read without the base64 text in memory too).
+MAX_DATA_URI_BYTES = 64 << 20
 
 # --------------------------------------------------------------------- proportional
 #: A file's decoded numeric data may be at most this many times its own bytes (plus
