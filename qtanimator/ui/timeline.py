@@ -35,7 +35,7 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator.document.commands import Macro, SetParameter
-from qtanimator.document.document import DocumentChange, split_channel_id
+from qtanimator.document.document import Document, DocumentChange, split_channel_id
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.playback import Playback, playback_frame
 
@@ -249,6 +249,8 @@ class CacheBar(QWidget):
         if progress(doc)[1]:
             self.ctx.watch_simulation()  # follow the worker while it runs
         failed = sorted((int(round(p.time * doc.fps)), p.message) for p in c2d.pendulum_problems(doc).values())
+        failed += _cloth_failures(doc)
+        failed.sort()
         if simulated != self._range or failed != self._failed:
             problems_changed = failed != self._failed
             self._range, self._failed = simulated, failed
@@ -281,6 +283,24 @@ class CacheBar(QWidget):
                 x = self.timeline.frame_to_x(frame)
                 p.fillRect(QRectF(x - 1.5, 0, 3.0, h), FAILED_COLOR)
         p.end()
+
+
+def _cloth_failures(doc: Document) -> list[tuple[int, str]]:
+    """``(frame, message)`` of each cloth whose cached simulation blew up."""
+    from qtanimator.document import cloth as cloth_doc
+
+    out = []
+    for aid, asset in list(doc.assets.items()):
+        if asset.kind != cloth_doc.ASSET_KIND:
+            continue
+        try:
+            problem = cloth_doc.cloth_problem(doc, aid)
+        except (KeyError, ValueError):  # not loadable: the 3D view reports it
+            continue
+        if problem is not None:
+            frame = doc.frame_range[0] + int(round(problem.time * doc.fps))
+            out.append((frame, f"cloth '{aid}': {problem.message}"))
+    return out
 
 
 class TimelinePanel(QWidget):
@@ -511,5 +531,8 @@ def install(window: MainWindow) -> None:
             window.statusBar().clearMessage()
 
     panel.timeline.cache_bar.problemsChanged.connect(show_problems)
+    view3d = getattr(window, "viewport3d", None)
+    if view3d is not None:  # the cloth cache's worker reports through the 3D view
+        view3d.clothProgressChanged.connect(lambda _progress: panel.timeline.cache_bar.refresh())
     # Stop playing when the document is replaced.
     ctx.documentReset.connect(playback.pause)

@@ -35,3 +35,22 @@ def test_a_pendulum_blow_up_is_shown_in_properties_cache_bar_and_status_bar(make
     window.ctx.undo_stack.undo()
     qtbot.waitUntil(lambda: not bar.failures(), timeout=20000)
     assert window.statusBar().currentMessage() == ""
+
+
+def test_a_cloth_blow_up_is_marked_on_the_cache_bar_and_in_the_status_bar(make_window, qtbot):
+    from qtanimator.core.cloth import ClothParams
+    from qtanimator.document.cloth import add_cloth_command
+
+    window = make_window(full=True)
+    params = ClothParams(rows=8, cols=8, structural_stiffness=1.0e4, substeps=1)
+    window.ctx.push(add_cloth_command(window.doc, params))
+    window.central_tabs.setCurrentWidget(window.viewport3d.parentWidget() or window.viewport3d)
+    window.ctx.set_frame(60.0)  # the 3D view asks for the cloth's frames: the worker blows up
+    bar = window.timeline_dock.widget().timeline.cache_bar
+    from qtanimator.document.cloth import cloth_problem
+    (aid,) = [a for a, asset in window.doc.assets.items() if asset.kind == "cloth"]
+    qtbot.waitUntil(lambda: cloth_problem(window.doc, aid) is not None, timeout=30000)
+    qtbot.waitUntil(lambda: any("cloth" in m for _f, m in bar.failures()), timeout=30000)
+    frame, message = next((f, m) for f, m in bar.failures() if "cloth" in m)
+    assert 0 < frame < 60 and "substeps" in message
+    assert window.statusBar().currentMessage().startswith("Simulation stopped: ")
