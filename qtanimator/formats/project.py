@@ -201,6 +201,14 @@ def _is_path_key(key: str, value: Any) -> bool:
     return key.endswith("_file") and isinstance(value, str) and bool(value)
 
 
+def _inside(path: Path, folder: Path) -> bool:
+    """True when ``path`` (after ``..`` and symbolic links) lies in ``folder``."""
+    try:
+        return path.resolve().is_relative_to(folder.resolve())
+    except (OSError, RuntimeError, ValueError):
+        return False
+
+
 def _leaves(relative: str) -> bool:
     """True for a stored path that leads out of the project folder."""
     return relative == ".." or relative.startswith("../") or Path(relative).is_absolute()
@@ -287,6 +295,15 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
             raise FormatError(f"asset {a['id']!r}: \"outside\" must be a list of names.", p)
         abs_source = _absolute(base, source, p) if source else None
         props = {k: (_absolute(base, v, p) if _is_path_key(k, v) else v) for k, v in props.items()}
+        # Containment (issue 19): a reference out of the project folder must be one the
+        # user chose, recorded in "outside"; a project cannot make us read /etc/passwd.
+        refs = [("source", source, abs_source)] if source else []
+        refs += [(k, a.get("properties", {})[k], v) for k, v in props.items() if _is_path_key(k, v)]
+        for key, stored, absolute in refs:
+            if key not in outside and not _inside(Path(absolute), base):
+                raise FormatError(f"asset {a['id']!r}: its {key} {stored!r} lies outside the project's folder, "
+                                  "and the project does not record that file as chosen (\"outside\"). Move the "
+                                  "file into the project's folder, or add it again with File ▸ Open.", p)
         data.assets.append(AssetRecord(a["id"], a["kind"], abs_source, props, list(outside)))
     channels = obj.get("channels", {})
     if not isinstance(channels, dict):

@@ -12,7 +12,7 @@ import bisect
 import math
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QPointF, QRectF, QSize, Qt, Signal
+from PySide6.QtCore import QElapsedTimer, QPointF, QRectF, QSize, Qt, QTimer, Signal
 from PySide6.QtGui import (
     QAction,
     QColor,
@@ -52,6 +52,8 @@ CACHE_BAR_HEIGHT = 4
 #: Simulated frames (Blender draws its simulation caches as a coloured band too).
 CACHE_COLOR = QColor(80, 170, 255)
 FAILED_COLOR = QColor(230, 60, 50)
+#: How often the cache bar checks the simulations even when no worker reported (ms).
+SLOW_REFRESH_MS = 250
 
 
 def key_frames(ctx: EditorContext, asset: str | None = None) -> list[float]:
@@ -226,6 +228,15 @@ class CacheBar(QWidget):
         #: How many times the band was recomputed (tests: at most once per progress signal).
         self.refreshes = 0
         self.ctx.simulationProgressed.connect(self.refresh)
+        # Workers report through polls that stop when they go idle; a slow timer makes sure
+        # the last state (a blow-up included) is shown whatever the order of events.
+        self._slow_refresh = QTimer(self)
+        self._slow_refresh.setObjectName("cacheBarRefresh")
+        self._slow_refresh.setInterval(SLOW_REFRESH_MS)
+        self._slow_refresh.timeout.connect(self._refresh_if_quiet)
+        self._slow_refresh.start()
+        self._since_refresh = QElapsedTimer()
+        self._since_refresh.start()
         self.ctx.documentChanged.connect(lambda _change: self.refresh())
         self.ctx.documentReset.connect(self.refresh)
         self.refresh()
@@ -239,11 +250,16 @@ class CacheBar(QWidget):
         """``(frame, message)`` of each blow-up that stopped a simulation."""
         return list(self._failed)
 
+    def _refresh_if_quiet(self) -> None:
+        if self._since_refresh.elapsed() >= SLOW_REFRESH_MS:
+            self.refresh()
+
     def refresh(self) -> None:
         from qtanimator.document import character2d as c2d
         from qtanimator.document.simulation import progress
 
         self.refreshes += 1
+        self._since_refresh.restart()
         doc = self.ctx.doc
         simulated = c2d.simulated_frames(doc)
         if progress(doc)[1]:

@@ -204,3 +204,29 @@ def test_a_huge_data_uri_is_refused_before_it_is_decoded(tmp_path: Path) -> None
             print("REFUSED", e)
     """)
     assert "REFUSED" in result.stdout and "MAX_DATA_URI_BYTES" in result.stdout, result.stderr[-2000:]
+
+
+def test_a_project_reads_outside_its_folder_only_what_it_records_as_chosen(tmp_path: Path) -> None:
+    from qtanimator.formats.project import load_project
+
+    folder = tmp_path / "project"
+    (folder / "art").mkdir(parents=True)
+    (folder / "art" / "a.svg").write_text("<svg/>")
+    (tmp_path / "elsewhere.svg").write_text("<svg/>")
+
+    def project(source: str, outside: list[str] | None = None) -> Path:
+        asset = {"id": "a", "kind": "character2d", "source": source, "properties": {}}
+        if outside is not None:
+            asset["outside"] = outside
+        path = folder / "p.qtanim"
+        path.write_text(json.dumps({"format": "qtanimator-project", "version": 2, "parameters": {},
+                                    "assets": [asset], "channels": {}}))
+        return path
+
+    assert load_project(project("art/a.svg")).assets[0].source == str((folder / "art" / "a.svg").resolve())
+    for hostile in ("/etc/passwd", "../../../../../etc/passwd", "art/../../elsewhere.svg"):
+        with pytest.raises(FormatError, match="outside the project's folder"):
+            load_project(project(hostile))
+    # Chosen by the user (File ▸ Open, Save As without collecting): recorded, so allowed.
+    assert load_project(project("../elsewhere.svg", ["source"])).assets[0].source == str(
+        (tmp_path / "elsewhere.svg").resolve())
