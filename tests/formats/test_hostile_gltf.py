@@ -118,6 +118,18 @@ def run_limited(script: str, timeout: float = 30.0, memory: int = 1 << 30) -> su
                           text=True, timeout=timeout)
 
 
+def import_in_limited_process(path: Path) -> subprocess.CompletedProcess[str]:
+    """import_gltf(path) in a limited child process; prints REFUSED and the message."""
+    return run_limited(f"""
+        from qtanimator.formats.gltf import import_gltf
+        from qtanimator.formats.errors import FormatError
+        try:
+            import_gltf({str(path)!r})
+        except FormatError as e:
+            print("REFUSED", e)
+    """)
+
+
 def zero_accessor_bomb(path: Path, accessors: int = 60, count: int = 1 << 20) -> None:
     """A file of a few kilobytes: many MAT4 accessors of a million elements each with no
     buffer view (all zeros by the specification), used as inverse bind matrices."""
@@ -134,14 +146,7 @@ def test_accessors_sharing_one_view_cannot_expand_without_bound(tmp_path: Path) 
     path = tmp_path / "bomb.gltf"
     zero_accessor_bomb(path)
     assert path.stat().st_size < 8192
-    result = run_limited(f"""
-        from qtanimator.formats.gltf import import_gltf
-        from qtanimator.formats.errors import FormatError
-        try:
-            import_gltf({str(path)!r})
-        except FormatError as e:
-            print("REFUSED", e)
-    """)
+    result = import_in_limited_process(path)
     assert "REFUSED" in result.stdout and "exceeds qtanimator's limit" in result.stdout, result.stderr[-2000:]
 
 
@@ -151,14 +156,7 @@ def test_a_skin_with_too_many_joints_is_refused(tmp_path: Path, joints: int) -> 
     doc = {"asset": {"version": "2.0"}, "nodes": [{} for _ in range(joints)],
            "skins": [{"joints": list(range(joints))}]}
     path.write_text(json.dumps(doc))
-    result = run_limited(f"""
-        from qtanimator.formats.gltf import import_gltf
-        from qtanimator.formats.errors import FormatError
-        try:
-            import_gltf({str(path)!r})
-        except FormatError as e:
-            print("REFUSED", e)
-    """)
+    result = import_in_limited_process(path)
     assert "REFUSED" in result.stdout and f"{MAX_JOINTS} joints" in result.stdout, result.stderr[-2000:]
 
 
@@ -195,14 +193,7 @@ def test_a_huge_data_uri_is_refused_before_it_is_decoded(tmp_path: Path) -> None
     path.write_text('{"asset": {"version": "2.0"}, "buffers": [{"byteLength": 4, "uri": '
                     '"data:application/octet-stream;base64,' + payload + '"}]}')
     del payload
-    result = run_limited(f"""
-        from qtanimator.formats.gltf import import_gltf
-        from qtanimator.formats.errors import FormatError
-        try:
-            import_gltf({str(path)!r})
-        except FormatError as e:
-            print("REFUSED", e)
-    """)
+    result = import_in_limited_process(path)
     assert "REFUSED" in result.stdout and "MAX_DATA_URI_BYTES" in result.stdout, result.stderr[-2000:]
 
 

@@ -7,9 +7,8 @@ import math
 from pathlib import Path
 
 import pytest
-from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
-from PySide6.QtGui import QMouseEvent
-from PySide6.QtWidgets import QApplication
+from PySide6.QtCore import QEvent, QPoint, Qt
+from rig_helpers import hand_point, send_mouse
 
 from qtanimator.core.channel import Key
 from qtanimator.document import character2d as c2d
@@ -31,33 +30,6 @@ def demo(make_window, qtbot):
     seen: list[DocumentChange] = []
     window.ctx.documentChanged.connect(seen.append)
     return window, view, seen
-
-
-def send_mouse(view, kind: QEvent.Type, pos: QPoint, button: Qt.MouseButton,
-               buttons: Qt.MouseButton) -> None:
-    """Deliver one real mouse event to the viewport without processing other events."""
-    vp = view.viewport()
-    local = QPointF(pos)
-    event = QMouseEvent(kind, local, vp.mapToGlobal(local), button, buttons, Qt.KeyboardModifier.NoModifier)
-    QApplication.sendEvent(vp, event)
-
-
-def hand_point(window, view) -> QPoint:
-    """A pixel on Pip's right hand that picks the hand."""
-    from qtanimator.ui.rig_interaction import pick
-
-    doc = window.doc
-    ch = doc.runtime["pip"]
-    j = ch.joint_index("hand_right")
-    pose = c2d.evaluate_pose(doc, "pip", window.ctx.time)
-    pts = ch.joints[j].shapes[0].points
-    centre = pts.mean(axis=0)
-    for local in [centre] + [centre + 0.5 * (p - centre) for p in pts]:
-        xy = view.from_scene(pose.to_world(j, local))
-        pixel = QPoint(int(round(xy.x())), int(round(xy.y())))
-        if pick(doc, window.ctx.time, view.to_scene(QPointF(pixel))) == ("pip", j):
-            return pixel
-    raise AssertionError("the hand is covered everywhere")
 
 
 def test_a_command_on_many_channels_is_one_notification(demo):

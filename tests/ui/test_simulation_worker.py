@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
-from PySide6.QtGui import QMouseEvent
+from PySide6.QtCore import QEvent, QPoint, Qt
 from PySide6.QtWidgets import QApplication, QWidget
+from rig_helpers import hand_point, send_mouse
 
 from qtanimator.document import character2d as c2d
 from qtanimator.document.document import DocumentChange
@@ -34,32 +34,6 @@ def demo(make_window, qtbot):
     yield window, view
     shutdown_all()
     assert running_workers() == []
-
-
-def send_mouse(view, kind: QEvent.Type, pos: QPoint, button: Qt.MouseButton,
-               buttons: Qt.MouseButton) -> None:
-    vp = view.viewport()
-    local = QPointF(pos)
-    event = QMouseEvent(kind, local, vp.mapToGlobal(local), button, buttons, Qt.KeyboardModifier.NoModifier)
-    QApplication.sendEvent(vp, event)
-
-
-def hand_point(window, view) -> QPoint:
-    """A pixel on Pip's right hand that picks the hand (a keyframed joint: exact at once)."""
-    from qtanimator.ui.rig_interaction import pick
-
-    doc = window.doc
-    ch = doc.runtime["pip"]
-    j = ch.joint_index("hand_right")
-    pose = c2d.evaluate_pose(doc, "pip", window.ctx.time, block=False)
-    pts = ch.joints[j].shapes[0].points
-    centre = pts.mean(axis=0)
-    for local in [centre] + [centre + 0.5 * (p - centre) for p in pts]:
-        xy = view.from_scene(pose.to_world(j, local))
-        pixel = QPoint(int(round(xy.x())), int(round(xy.y())))
-        if pick(doc, window.ctx.time, view.to_scene(QPointF(pixel))) == ("pip", j):
-            return pixel
-    raise AssertionError("the hand is covered everywhere")
 
 
 def ui_steps(sim: c2d.PendulumCache) -> int:
