@@ -12,6 +12,8 @@ import bisect
 import math
 from typing import TYPE_CHECKING
 
+import numpy as np
+import numpy.typing as npt
 from PySide6.QtCore import QElapsedTimer, QPointF, QRectF, QSize, Qt, QTimer, Signal
 from PySide6.QtGui import (
     QAction,
@@ -34,6 +36,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from qtanimator.core.channel import Channel
 from qtanimator.document.commands import Macro, SetParameter
 from qtanimator.document.document import Document, DocumentChange, split_channel_id
 from qtanimator.ui.context import EditorContext
@@ -54,18 +57,36 @@ CACHE_COLOR = QColor(80, 170, 255)
 FAILED_COLOR = QColor(230, 60, 50)
 #: How often the cache bar checks the simulations even when no worker reported (ms).
 SLOW_REFRESH_MS = 250
+FloatArray = npt.NDArray[np.float64]
 
 
-def key_frames(ctx: EditorContext, asset: str | None = None) -> list[float]:
-    """Sorted frames that hold a key in any channel (of ``asset`` when given)."""
+#: Per channel id: the channel object and its key frames at an fps. Channels are immutable
+#: (an edit makes a new object), so a drag recomputes only the dragged channels.
+FrameCache = dict[str, tuple[Channel, float, FloatArray]]
+
+
+def key_frames(ctx: EditorContext, asset: str | None = None, cache: FrameCache | None = None) -> list[float]:
+    """Sorted frames that hold a key in any channel (of ``asset`` when given). ``cache``
+    keeps each channel's frames between calls (entries of removed channels are dropped)."""
     fps = ctx.doc.fps
-    frames: set[float] = set()
+    arrays = []
     for cid, ch in ctx.doc.channels.items():
-        if asset is not None and split_channel_id(cid)[0] != asset:
+        if not ch.keys or (asset is not None and split_channel_id(cid)[0] != asset):
             continue
-        for k in ch.keys:
-            frames.add(round(k.time * fps, 6))
-    return sorted(frames)
+        hit = cache.get(cid) if cache is not None else None
+        if hit is not None and hit[0] is ch and hit[1] == fps:
+            frames = hit[2]
+        else:
+            frames = np.round(ch.times * fps, 6)
+            if cache is not None:
+                cache[cid] = (ch, fps, frames)
+        arrays.append(frames)
+    if cache is not None and len(cache) > len(ctx.doc.channels):
+        for cid in [c for c in cache if c not in ctx.doc.channels]:
+            del cache[cid]
+    if not arrays:
+        return []
+    return [float(f) for f in np.unique(np.concatenate(arrays))]
 
 
 class TimelineWidget(QWidget):
@@ -81,6 +102,7 @@ class TimelineWidget(QWidget):
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self.setMouseTracking(False)
         self._keys: list[float] | None = None
+        self._frame_cache: FrameCache = {}
         self._selected_keys: list[float] | None = None
         ctx.frameChanged.connect(lambda _f: self.update())
         ctx.documentChanged.connect(self._on_document_changed)
@@ -112,13 +134,13 @@ class TimelineWidget(QWidget):
 
     def keys(self) -> list[float]:
         if self._keys is None:
-            self._keys = key_frames(self.ctx)
+            self._keys = key_frames(self.ctx, cache=self._frame_cache)
         return self._keys
 
     def selected_keys(self) -> list[float]:
         if self._selected_keys is None:
             asset = self.ctx.selection[0]
-            self._selected_keys = key_frames(self.ctx, asset) if asset else []
+            self._selected_keys = key_frames(self.ctx, asset, self._frame_cache) if asset else []
         return self._selected_keys
 
     # ---------------------------------------------------------- geometry
