@@ -15,6 +15,7 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
 from PySide6.QtCore import QPoint, Qt
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import (
@@ -31,7 +32,7 @@ from PySide6.QtWidgets import (
 from qtanimator.core.channel import Extrapolation, Tangent
 from qtanimator.document.commands import SetExtrapolation, SetTangents
 from qtanimator.document.curve_commands import SetKeysBroken
-from qtanimator.document.document import DocumentChange
+from qtanimator.document.document import DocumentChange, split_channel_id
 from qtanimator.ui.curves.fields import KeyFields
 from qtanimator.ui.curves.tree import ChannelTree
 from qtanimator.ui.curves.view import CurveView
@@ -242,6 +243,10 @@ class CurveEditor(QWidget):
         self.view.reset()
         self.tree.set_channels(list(self.ctx.doc.channels))
         self._apply_visibility()
+        # Positions in hundreds of units beside rotations in radians would flatten the
+        # rotations to a line: open such a document normalised (every curve to -1…1).
+        if _ranges_differ(self.ctx.doc.channels, self.view.visible) and not self.view.normalised:
+            self.view.set_normalised(True)
         self.view.frame_all()
         self._update_enabled()
 
@@ -275,6 +280,8 @@ class CurveEditor(QWidget):
         cids = [c for c in self.tree.channel_ids() if c.startswith(prefix)] if asset else []
         self.tree.show_selection(asset, joint)
         self._highlight(cids)
+        if cids and not self.view.selected_keys():
+            self.view.frame_selected()  # like Maya's auto frame: the joint's curves fill the view
 
     def _context_channels(self, cids: list[str]) -> None:
         if self._echo:
@@ -282,6 +289,29 @@ class CurveEditor(QWidget):
         if self.tree.selected_channels() != list(cids):
             self.tree.show_selection("", "", cids)
         self._highlight(cids)
+
+
+#: A document opens normalised when its position curves span this many times more than its
+#: rotation curves (medians over the visible channels).
+NORMALISE_RANGE_RATIO = 20.0
+POSITION_DOFS = frozenset({"x", "y", "z", "tx", "ty", "tz"})
+
+
+def _ranges_differ(channels: Any, visible: Any) -> bool:
+    """True when position and rotation curves are both visible and the positions' spans
+    dwarf the rotations' (pixels, SVG units or metres beside radians)."""
+    spans: dict[bool, list[float]] = {True: [], False: []}
+    for cid in visible:
+        ch = channels.get(cid)
+        if ch is None or len(ch.keys) < 2:
+            continue
+        values = ch.values
+        span = float(values.max() - values.min())
+        if span > 0:
+            spans[split_channel_id(cid)[2] in POSITION_DOFS].append(span)
+    if not spans[True] or not spans[False]:
+        return False
+    return float(np.median(spans[True])) > NORMALISE_RANGE_RATIO * float(np.median(spans[False]))
 
 
 def install(window: Any) -> CurveEditor:

@@ -37,26 +37,31 @@ from qtanimator.ui.joint_tree import c2d, c3d
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
 
-PENDULUM_LABELS = {
-    "g": "Gravity g (units/s²)",
-    "damping": "Damping a (1/s)",
-    "length_scale": "Length scale",
-    "accel_scale": "Translation accel. scale",
-    "rotation_accel_scale": "Rotation accel. scale",
-    "inertia": "Moments of inertia",
-    "point_mass_forcing": "Point-mass forcing (1/L²)",
-    "coupled": "Coupled chains",
-    "integrator": "Integrator",
-    "step": "Internal step (s)",
+#: Labels in the animator's words, and tool tips that keep the physics and course names.
+PENDULUM_LABELS: dict[str, tuple[str, str]] = {
+    "g": ("Gravity", "g, in scene units per second² (pulls down the screen)"),
+    "damping": ("Damping", "how fast the swing dies out: a in ω ← ω·e^(−a·τ), per second"),
+    "length_scale": ("Length scale", "multiplies the pivot-to-centre-of-mass lengths (the course handout uses 1/1000)"),
+    "accel_scale": ("Follow the body", "how much the character's movement swings the pendulums "
+                                       "(translation acceleration scale)"),
+    "rotation_accel_scale": ("Follow the parent's rotation", "how much keyframed parents turning swings the "
+                                                              "pendulums (rotation acceleration scale)"),
+    "inertia": ("Inertia from", "exact: from the drawn shapes; reference: the course starter's formulas"),
+    "point_mass_forcing": ("Point-mass swing", "the course handout's 1/L² forcing in place of m/I"),
+    "coupled": ("Chains swing together", "solve chains of pendulums as one coupled system"),
+    "integrator": ("Integrator", "symplectic Euler (the course's), leapfrog or Runge–Kutta 4"),
+    "step": ("Simulation step (s)", "the fixed internal time step; smaller is steadier and slower"),
 }
-IK_LABELS = {
-    "ik.solver": "Solver",
-    "ik.freeze_root": "Freeze root",
-    "ik.max_iterations": "Max iterations",
-    "ik.damping": "DLS damping",
-    "ik.handout_step": "Handout step τ",
-    "ik.handout_iterations": "Handout steps per move",
-    "ik.gradient_arrow_scale": "Gradient arrow scale",
+IK_LABELS: dict[str, tuple[str, str]] = {
+    "ik.solver": ("Solver", "dls: damped least squares, respects joint limits (recommended); "
+                            "handout: the course handout's gradient descent"),
+    "ik.freeze_root": ("Keep the root still", "the dragged chain stops below the character's root joint"),
+    "ik.max_iterations": ("Precision (iterations)", "more iterations reach the cursor more exactly"),
+    "ik.damping": ("Smoothness", "damped least squares' damping λ: higher is steadier near full stretch"),
+    "ik.handout_step": ("Gradient step (handout solver)", "τ in the handout's update θ ← θ + τ·D"),
+    "ik.handout_iterations": ("Gradient steps per move (handout solver)", "updates of the handout's solver "
+                                                                          "per mouse move"),
+    "ik.gradient_arrow_scale": ("Debug arrow length", "length of the gradient arrows of the debug overlay"),
 }
 IK_CHOICES = {"ik.solver": ["dls", "handout"]}
 
@@ -324,9 +329,10 @@ class PropertiesPanel(QWidget):
                 choices = ["exact", "reference"]
             elif f.name == "integrator":
                 choices = list(INTEGRATORS)
-            editor = self._parameter_editor(form, PENDULUM_LABELS.get(f.name, f.name), path, default, choices,
-                                            decimals=6)
-            editor.setToolTip(f"default {getattr(defaults, f.name)!r}")
+            label, tip = PENDULUM_LABELS.get(f.name, (f.name, ""))
+            editor = self._parameter_editor(form, label, path, default, choices, decimals=6)
+            editor.setToolTip(f"{tip} (default {getattr(defaults, f.name)!r})" if tip else
+                              f"default {getattr(defaults, f.name)!r}")
             # What is shown is the effective value (preset + overrides).
             self._refreshers.append(self._effective_refresher(editor, asset, f.name))
         problem = QLabel()
@@ -385,8 +391,9 @@ class PropertiesPanel(QWidget):
         group.setObjectName("ikProperties")
         form = QFormLayout(group)
         for path, default in IK_DEFAULTS.items():
-            self._parameter_editor(form, IK_LABELS.get(path, path), path, default, IK_CHOICES.get(path),
-                                   decimals=6)
+            label, tip = IK_LABELS.get(path, (path, ""))
+            editor = self._parameter_editor(form, label, path, default, IK_CHOICES.get(path), decimals=6)
+            editor.setToolTip(tip)
         return group
 
 
