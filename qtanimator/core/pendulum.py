@@ -34,6 +34,9 @@ from qtanimator.core.rig2d import Character
 FloatArray = npt.NDArray[np.float64]
 
 INTEGRATORS = ("symplectic_euler", "leapfrog", "rk4")
+#: The smallest internal step (s): 1,667 steps per 60 Hz frame. A step of 1e-9 s would make
+#: one frame 16 million steps, a simulation that never ends.
+MIN_STEP = 1.0e-5
 
 
 @dataclass(frozen=True)
@@ -64,8 +67,8 @@ class PendulumParams:
             raise ValueError("inertia must be 'exact' or 'reference'")
         if self.integrator not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}")
-        if not (self.step > 0 and math.isfinite(self.step)):
-            raise ValueError("the step must be a positive number of seconds")
+        if not (self.step >= MIN_STEP and math.isfinite(self.step)):
+            raise ValueError(f"the step must be at least {MIN_STEP:g} s (a frame would take too many steps)")
         for name in ("g", "damping", "length_scale", "accel_scale", "rotation_accel_scale"):
             if not math.isfinite(float(getattr(self, name))):
                 raise ValueError(f"{name} must be finite")
@@ -134,6 +137,13 @@ def check_state(character: Character, params: PendulumParams, theta: FloatArray,
         f"spinning at {abs(float(omega[k])):.3g} rad/s"
     return PendulumBlowUp(f"the pendulum '{name}' blew up at {time:.3f} s ({what}): {advice}.",
                           parameter, time, name)
+
+
+def _decay(damping: float, tau: float) -> float:
+    """e^(−a·τ), the damping factor of one step; a negative damping so strong that the
+    factor overflows gives inf (the blow-up check then reports it) instead of an error."""
+    exponent = -damping * tau
+    return math.inf if exponent > 709.0 else math.exp(exponent)
 
 
 def rotate(v: FloatArray, theta: FloatArray | float) -> FloatArray:
@@ -272,7 +282,7 @@ class PendulumSystem:
         Hamiltonian systems (symplectic Euler gains energy there), so they use RK4.
         """
         tau = self.params.step if tau is None else tau
-        decay = math.exp(-self.params.damping * tau)
+        decay = _decay(self.params.damping, tau)
         idx = self._singles[0]
         if len(idx):
             if callable(pivot_acc):
@@ -298,7 +308,7 @@ class PendulumSystem:
         acc_all = np.asarray(pivot_acc, dtype=np.float64).reshape(len(theta), 2)
         idx = self._singles[0]
         acc = acc_all[idx]
-        decay = math.exp(-self.params.damping * tau)
+        decay = _decay(self.params.damping, tau)
         method = self.params.integrator
         traj_t = np.empty((steps, len(theta)))
         traj_w = np.empty((steps, len(theta)))

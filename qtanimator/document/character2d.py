@@ -686,7 +686,9 @@ class PendulumCache:
             theta, omega = self._initial(doc, asset_id, sim)
             steps = 0
         else:
-            theta, omega, steps = self._advance(doc, asset_id, sim, start + index - 1, prev[0], prev[1])
+            # A blow-up makes inf and NaN on the way; check_state below reports it.
+            with np.errstate(over="ignore", invalid="ignore"):
+                theta, omega, steps = self._advance(doc, asset_id, sim, start + index - 1, prev[0], prev[1])
         ident = threading.get_ident()
         problem = check_state(sim.system.character, sim.system.params, theta, omega, (start + index) / doc.fps)
         with self._lock:

@@ -297,7 +297,7 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
         props = {k: (_absolute(base, v, p) if _is_path_key(k, v) else v) for k, v in props.items()}
         # Containment (issue 19): a reference out of the project folder must be one the
         # user chose, recorded in "outside"; a project cannot make us read /etc/passwd.
-        refs = [("source", source, abs_source)] if source else []
+        refs: list[tuple[str, str, str]] = [("source", source, abs_source)] if source and abs_source else []
         refs += [(k, a.get("properties", {})[k], v) for k, v in props.items() if _is_path_key(k, v)]
         for key, stored, absolute in refs:
             if key not in outside and not _inside(Path(absolute), base):

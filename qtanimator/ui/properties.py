@@ -86,7 +86,7 @@ class PropertiesPanel(QWidget):
         ctx.documentReset.connect(self.rebuild)
         ctx.documentChanged.connect(self._on_document)
         ctx.frameChanged.connect(lambda _f: self.refresh())
-        ctx.simulationProgressed.connect(lambda: [fn() for fn in self._simulation_refreshers])
+        ctx.simulationProgressed.connect(self._simulation_progressed)
         self.rebuild()
 
     # ------------------------------------------------------------ structure
@@ -103,6 +103,10 @@ class PropertiesPanel(QWidget):
             return True
         asset = self.ctx.selection[0]
         return bool(asset) and asset in change.channel_assets()
+
+    def _simulation_progressed(self) -> None:
+        for fn in self._simulation_refreshers:
+            fn()
 
     def refresh(self) -> None:
         for fn in self._refreshers:
