@@ -141,9 +141,6 @@ def _gui(args: list[str]) -> int:
     from qtanimator.ui.errors import install_excepthook
     from qtanimator.ui.main_window import MainWindow
 
-    # Simulation and autosave workers share the GIL with the UI thread: hand it over every
-    # millisecond (Python's default is 5 ms) so the UI's turn comes well inside a frame.
-    sys.setswitchinterval(0.001)
     # The desktop entry's name: Wayland compositors match windows to it (icon, grouping).
     QGuiApplication.setDesktopFileName(APP_ID)
     app = QApplication.instance() or QApplication(sys.argv[:1])

@@ -197,12 +197,21 @@ drag_forces = _lazy(_drag_forces)
 symplectic_substep = _lazy_fused(_symplectic_substep)
 
 
+_WARM = False
+
+
 def warm_up() -> float:
-    """Compile (or load from the cache) every kernel; returns the seconds it took."""
+    """Compile (or load from the cache) every kernel; returns the seconds it took (nothing
+    after the first call). Loading numba and the cached kernels takes a few hundred
+    milliseconds of interpreter time: the application does it while it builds its window,
+    so that the first cloth frame a worker computes does not take it from the UI thread
+    while the user plays or drags."""
     import time
 
+    global _WARM
     t0 = time.perf_counter()
-    if HAVE_NUMBA:
+    if HAVE_NUMBA and not _WARM:
+        _WARM = True
         x = np.zeros((3, 3))
         x[1, 0] = 1.0
         x[2, 1] = 1.0

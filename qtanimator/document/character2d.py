@@ -39,7 +39,7 @@ from qtanimator.core.pendulum import PRESETS, PendulumBlowUp, PendulumParams, Pe
 from qtanimator.core.rig2d import Character, Pose
 from qtanimator.document.commands import AddAsset, Command, DeleteKeys, Macro, SetKeys, SetParameter
 from qtanimator.document.document import Asset, Document, DocumentChange, channel_id, split_channel_id
-from qtanimator.document.simulation import SimulationWorker
+from qtanimator.document.simulation import SimulationWorker, ui_idle
 
 ASSET_KIND = "character2d"
 KEY_ALL_PARAMETER = "animation.key_all"
@@ -424,6 +424,7 @@ class PendulumCache:
 
     def wait_idle(self, timeout: float = 30.0) -> bool:
         """Block until the worker has nothing to do (tests); False on timeout."""
+        ui_idle()  # the calling thread waits: the worker need not leave it the interpreter
         deadline = time.monotonic() + timeout
         while self._worker.busy:
             if time.monotonic() > deadline:

@@ -41,7 +41,7 @@ from qtanimator.core.cloth import (
 )
 from qtanimator.document.cloth import ASSET_KIND, ClothCache, cloth_cache, cloth_params
 from qtanimator.document.document import Document, DocumentChange
-from qtanimator.document.simulation import SimulationWorker
+from qtanimator.document.simulation import SimulationWorker, ui_idle
 
 #: Parameters that set every cloth's frame grid: a change rebuilds every cloth cache.
 GRID_PARAMETERS = frozenset({"fps", "frame_start"})
@@ -271,6 +271,7 @@ class ClothWorker:
 
     def wait(self, timeout: float | None = None) -> bool:
         """Block until no cache needs work (True) or ``timeout`` seconds passed (False)."""
+        ui_idle()  # the calling thread waits: the worker need not leave it the interpreter
         deadline = None if timeout is None else time.monotonic() + timeout
         while self.busy:
             if deadline is not None and time.monotonic() >= deadline:

@@ -67,6 +67,31 @@ def workers_paused() -> bool:
     return not _RESUMED.is_set()
 
 
+#: Set while the UI thread's event loop waits for events (or when there is no UI). Python
+#: threads share one interpreter lock, and every Qt call the UI thread makes hands the lock
+#: over: while a worker computes, each of those calls waits up to a switch interval to get
+#: it back, so a paint of a few hundred calls takes tens of milliseconds instead of one.
+#: The workers therefore run their frames (about a millisecond each) while the UI thread
+#: idles; when it stays busy longer than :data:`UI_BUSY_WAIT_S` a worker goes on anyway, so
+#: a simulation always makes progress.
+_UI_IDLE = threading.Event()
+_UI_IDLE.set()
+#: The longest a worker waits for the UI thread to go idle before its next frame (s).
+UI_BUSY_WAIT_S = 0.05
+
+
+def ui_busy() -> None:
+    """The UI thread is handling events (the event dispatcher woke up)."""
+    if _UI_IDLE.is_set():  # is_set takes no lock: the common case costs nothing
+        _UI_IDLE.clear()
+
+
+def ui_idle() -> None:
+    """The UI thread waits for events (the event dispatcher is about to block)."""
+    if not _UI_IDLE.is_set():
+        _UI_IDLE.set()
+
+
 class SimulationCache(Protocol):
     """What the UI polls on every cache in ``doc.caches``."""
 
@@ -170,6 +195,7 @@ class SimulationWorker:
                             break
                     if should_stop():
                         break
+                    _UI_IDLE.wait(UI_BUSY_WAIT_S)  # let a busy UI thread finish first
                     job = self._job()
                     if job is None:  # the cache (its document) is gone
                         stop.set()

@@ -13,18 +13,58 @@ view refreshes at most once per frame, from one change that names everything tha
 
 from __future__ import annotations
 
-from PySide6.QtCore import QElapsedTimer, QEvent, QObject, QTimer, Signal
+import sys
+
+from PySide6.QtCore import QAbstractEventDispatcher, QCoreApplication, QElapsedTimer, QEvent, QObject, QTimer, Signal
 from PySide6.QtGui import QUndoStack
 
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, DocumentChange
 from qtanimator.document.gesture import Gesture
-from qtanimator.document.simulation import ensure_caches, pause_workers, resume_workers, stop_simulations
+from qtanimator.document.simulation import (
+    ensure_caches,
+    pause_workers,
+    resume_workers,
+    stop_simulations,
+    ui_busy,
+    ui_idle,
+)
 from qtanimator.document.simulation import progress as simulation_progress
 from qtanimator.ui.undo import push_command, record_command
 
 #: The frame clock's period: views refresh at most once per 60 Hz frame during a gesture.
 FRAME_INTERVAL_MS = 16
+
+
+class _BusyMarker(QObject):
+    """Marks the UI thread busy as soon as it delivers an event (an application-wide event
+    filter): with the GLib dispatcher the events of one iteration are delivered after
+    ``aboutToBlock`` and before ``awake``."""
+
+    def eventFilter(self, _watched: QObject, _event: QEvent) -> bool:
+        ui_busy()
+        return False
+
+
+def gate_workers_on_idle() -> bool:
+    """Let the simulation workers run while the UI thread's event loop idles (see
+    ``document.simulation.ui_idle``): the event dispatcher of the application's thread says
+    when it is about to wait and when it woke up. Once per application; False when there is
+    no application or dispatcher yet."""
+    app = QCoreApplication.instance()
+    dispatcher = QAbstractEventDispatcher.instance(app.thread()) if app is not None else None
+    if dispatcher is None:
+        return False
+    if not dispatcher.property("qtanimatorWorkerGate"):
+        # When a worker does run beside a busy UI thread (it waited its longest), hand the
+        # interpreter over every millisecond, not every 5 ms (Python's default).
+        sys.setswitchinterval(min(sys.getswitchinterval(), 0.001))
+        dispatcher.aboutToBlock.connect(ui_idle)
+        dispatcher.awake.connect(ui_busy)
+        marker = _BusyMarker(app)
+        app.installEventFilter(marker)
+        dispatcher.setProperty("qtanimatorWorkerGate", True)
+    return True
 
 
 class EditorContext(QObject):
@@ -62,6 +102,7 @@ class EditorContext(QObject):
         #: How many times ``documentChanged`` was emitted (tests count refreshes with it).
         self.notifications = 0
         ensure_caches(self.doc)  # caches drop invalid frames before views hear of a change
+        gate_workers_on_idle()
         self.doc.subscribe(self._on_document_event)
         # Simulation polling: the worker thread cannot touch Qt, so the UI thread compares
         # its revision once per frame while it works (see watch_simulation).

@@ -29,6 +29,7 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator import __version__
+from qtanimator.core.cloth_kernels import warm_up
 from qtanimator.document.asset_files import ASSETS_FOLDER, FileRef, collect_assets, file_refs, is_inside
 from qtanimator.document.document import Document
 from qtanimator.document.io import Relink, open_document_relinked, save_document
@@ -74,6 +75,9 @@ class MainWindow(QMainWindow):
         """``install_editors``: True for every editor, False for the bare shell, or the
         short names of the editor modules to install (``{"timeline", "rig_editor"}``)."""
         super().__init__()
+        # Numba and the cloth kernels load while the window is built, not at the first cloth
+        # frame (which would hold the interpreter while the user already plays or drags).
+        warm_up()
         self.setObjectName("mainWindow")
         self.setWindowIcon(QIcon(str(app_icon_path())))
         self.ctx = EditorContext(doc, self)

@@ -26,7 +26,7 @@ import time as _time
 from typing import Any
 
 import numpy as np
-from PySide6.QtCore import QElapsedTimer, QObject, QPointF, Qt, QTimer, Signal
+from PySide6.QtCore import QElapsedTimer, QEvent, QObject, QPointF, Qt, QTimer, Signal
 from PySide6.QtGui import QImage, QKeyEvent, QMouseEvent, QPixmap, QSurfaceFormat, QWheelEvent
 from PySide6.QtOpenGL import QOpenGLWindow
 from PySide6.QtOpenGLWidgets import QOpenGLWidget
@@ -220,6 +220,8 @@ class Viewport3D(QWidget):
         self._grid_pending = False  # a restored camera: size the grid at the first paint
         self._drag: dict[str, Any] | None = None
         self._press_pos = QPointF()
+        self._prepare_state = ""    # prepare_gl: "", "context", "resources", "picture", "done"
+        self._defer_renderer = False
         ctx.frameChanged.connect(lambda _f: self.update())
         ctx.selectionChanged.connect(lambda _a, _j: self.update())
         ctx.documentChanged.connect(self._on_document_changed)
@@ -290,12 +292,77 @@ class Viewport3D(QWidget):
 
     # ----------------------------------------------------------------- GL
     def update(self) -> None:  # type: ignore[override]
-        """Ask for a new picture (drawn at the next frame)."""
+        """Ask for a new picture (drawn at the next frame). A hidden GL window is not asked:
+        it paints when it is exposed, and a request left pending would make a second
+        picture right after that one."""
+        if self.surface_kind == "window" and not self.gl.isExposed():
+            return
         self.gl.update()
 
     def format(self) -> QSurfaceFormat:
         """The GL surface's format (OpenGL 3.3 core, depth, multisampling)."""
         return self.gl.format()
+
+    # ------------------------------------------------------- preparing early
+    #: Platforms whose GL windows can be prepared before they are shown.
+    PREPARE_PLATFORMS = ("xcb", "wayland", "eglfs", "windows", "cocoa")
+
+    def prepare_gl(self) -> bool:
+        """Create the GL context and resources and draw one picture while the view is still
+        hidden (another tab is current), in three steps of one event-loop turn each, so that
+        opening the "3D" tab later only shows a picture. On llvmpipe the context costs about
+        45 ms, the programs and meshes 10 ms and the first picture (shader variants compiled
+        at the first draw) 10–40 ms: together they stalled the tab's first opening.
+
+        Starts nothing when the view is already shown or prepared, for a QOpenGLWidget
+        surface (Qt makes its context only when shown), or on a platform without real
+        windows. True when the steps were started."""
+        from PySide6.QtGui import QGuiApplication
+
+        if (self.surface_kind != "window" or self._prepare_state != "" or self.gl.isExposed()
+                or QGuiApplication.platformName() not in self.PREPARE_PLATFORMS):
+            return False
+        self._prepare_state = "context"
+        QTimer.singleShot(0, self, self._prepare_step)  # dropped if the view goes
+        return True
+
+    def _prepare_step(self) -> None:
+        from PySide6.QtCore import QSize
+        from PySide6.QtGui import QResizeEvent
+
+        state = self._prepare_state
+        gl = self.gl
+        if gl.isExposed() or not isinstance(gl, _GLWindowSurface) or state in ("", "done"):
+            self._prepare_state = "done"  # shown meanwhile: Qt does the rest as usual
+            return
+        size = self.surface_widget.size()
+        w, h = max(size.width(), 1), max(size.height(), 1)
+        if state == "context":
+            gl.create()
+            gl.resize(w, h)
+            # QOpenGLWindow makes its context (and calls initializeGL) in its resize event.
+            self._defer_renderer = True
+            try:
+                QOpenGLWindow.resizeEvent(gl, QResizeEvent(QSize(w, h), QSize()))
+            finally:
+                self._defer_renderer = False
+            self._prepare_state = "resources" if gl.context() is not None else "done"
+        elif state == "resources":
+            gl.makeCurrent()
+            if not self.renderer.initialized:
+                self.renderer.initialize()
+            gl.doneCurrent()
+            self._prepare_state = "picture"
+        elif state == "picture":
+            gl.makeCurrent()
+            ratio = gl.devicePixelRatio()
+            # Into the hidden window's back buffer (never swapped): compiles what the first
+            # visible picture would, and sizes the camera to the scene.
+            self._draw(self.renderer, max(1, int(w * ratio)), max(1, int(h * ratio)))
+            gl.doneCurrent()
+            self._prepare_state = "done"
+        if self._prepare_state != "done":
+            QTimer.singleShot(0, self, self._prepare_step)  # dropped if the view goes
 
     def initialize_gl(self) -> None:
         """The surface's initializeGL: its context is current."""
@@ -304,7 +371,8 @@ class Viewport3D(QWidget):
         version = GL.glGetString(GL.GL_VERSION)
         renderer = GL.glGetString(GL.GL_RENDERER)
         self.gl_info = f"{version.decode() if version else '?'} / {renderer.decode() if renderer else '?'}"
-        self.renderer.initialize()
+        if not self._defer_renderer:  # prepare_gl makes the programs and meshes in a later step
+            self.renderer.initialize()
         context = self.gl.context()
         if context is not None:
             context.aboutToBeDestroyed.connect(self._release_gl)
@@ -962,8 +1030,29 @@ def grab_with_3d(widget: QWidget) -> QPixmap:
     return pixmap
 
 
+#: Milliseconds after the main window first shows before the hidden 3D view prepares its GL
+#: context (see :meth:`Viewport3D.prepare_gl`): after start-up work, before a user's click.
+PREPARE_DELAY_MS = 250
+
+
+class _PrepareOnShow(QObject):
+    """Starts ``view.prepare_gl`` once, shortly after the main window is first shown."""
+
+    def __init__(self, window: QWidget, view: Viewport3D) -> None:
+        super().__init__(window)
+        self.view = view
+        window.installEventFilter(self)
+
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
+        if event.type() == QEvent.Type.Show:
+            watched.removeEventFilter(self)
+            QTimer.singleShot(PREPARE_DELAY_MS, self.view, self.view.prepare_gl)
+        return False
+
+
 def install(window: Any) -> None:
     panel = ViewportPanel(window.ctx, window, window)
+    _PrepareOnShow(window, panel.view)
     window.viewport_panel = panel
     window.viewport3d = panel.view
     window.save_hooks.append(panel.view.store_camera)

@@ -317,3 +317,52 @@ def test_a_job_error_ends_the_run_and_is_kept() -> None:
     assert isinstance(worker.error, ValueError) and calls == [1]
     worker.shutdown()
     assert not worker.alive
+
+
+def test_a_worker_leaves_a_busy_ui_thread_alone_until_it_idles(monkeypatch: pytest.MonkeyPatch) -> None:
+    """While the UI thread says it is busy, a woken worker starts no frame (up to its
+    longest wait); the first ``ui_idle`` lets it run; a blocking wait counts as idle."""
+    from qtanimator.document import simulation
+
+    monkeypatch.setattr(simulation, "UI_BUSY_WAIT_S", 60.0)
+    calls: list[int] = []
+    started = threading.Event()
+
+    def job(_should_stop: Callable[[], bool]) -> bool:
+        calls.append(1)
+        started.set()
+        return len(calls) < 5
+
+    simulation.ui_busy()
+    try:
+        worker = SimulationWorker(job, "test-gate")
+        worker.wake()
+        assert not started.wait(0.3)   # the UI thread is busy: nothing ran
+        assert calls == [] and worker.busy
+        simulation.ui_idle()
+        assert started.wait(10)
+        for _ in range(1000):
+            if not worker.busy:
+                break
+            threading.Event().wait(0.01)
+        assert calls == [1] * 5
+        worker.shutdown()
+    finally:
+        simulation.ui_idle()
+
+
+def test_waiting_for_the_pendulum_cache_marks_the_caller_idle(demo: Callable[[], Document],
+                                                               monkeypatch: pytest.MonkeyPatch) -> None:
+    """A thread blocked in ``wait_idle`` is not busy: the worker fills the cache."""
+    from qtanimator.document import simulation as gate
+
+    monkeypatch.setattr(gate, "UI_BUSY_WAIT_S", 60.0)
+    doc = demo()
+    cache = simulation(doc)
+    gate.ui_busy()
+    try:
+        cache.latest_state("pip", 30)
+        assert cache.wait_idle(60)
+        assert cache.cached_frames("pip") > 30
+    finally:
+        gate.ui_idle()

@@ -140,3 +140,41 @@ def test_closing_the_window_stops_the_worker(demo, qtbot):
     assert sim.worker.alive
     window.close()
     assert not sim.worker.alive
+
+
+def test_the_ui_thread_is_busy_while_it_handles_events_and_idle_while_it_waits(qtbot):
+    """The gate the workers wait on (document.simulation.ui_idle): an event being handled
+    marks the UI thread busy; an event loop waiting for events marks it idle."""
+    import time
+
+    from qtanimator.document import simulation as gate
+    from qtanimator.ui.context import gate_workers_on_idle
+
+    assert gate_workers_on_idle()
+    seen: list[bool] = []
+
+    class Probe(QWidget):
+        def event(self, e):  # type: ignore[no-untyped-def]
+            if e.type() == QEvent.Type.User:
+                seen.append(gate._UI_IDLE.is_set())
+            return super().event(e)
+
+    probe = Probe()
+    gate.ui_idle()
+    QApplication.postEvent(probe, QEvent(QEvent.Type.User))
+    qtbot.waitUntil(lambda: bool(seen))
+    assert seen == [False]
+    samples: list[bool] = []
+    stop = threading.Event()
+
+    def sample() -> None:
+        while not stop.is_set():
+            samples.append(gate._UI_IDLE.is_set())
+            time.sleep(0.001)
+
+    sampler = threading.Thread(target=sample)
+    sampler.start()
+    qtbot.wait(150)  # an event loop with nothing to do
+    stop.set()
+    sampler.join()
+    assert any(samples)

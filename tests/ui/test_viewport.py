@@ -516,3 +516,56 @@ def test_escape_during_a_light_drag_puts_the_light_back_without_an_undo_step(win
     qtbot.mouseRelease(view, Qt.MouseButton.LeftButton, pos=a + QPoint(-20, 0))
     np.testing.assert_allclose(lights_of(window.doc)[0].position, before)
     assert window.ctx.undo_stack.count() == 0 and not window.ctx.undo_stack.canRedo()
+
+
+def _window_with_hidden_3d(qtbot):
+    from qtanimator.document.character3d import add_character3d_command
+    from qtanimator.paths import scenes_dir
+
+    w = MainWindow(install_editors=("rig_editor", "viewport"))
+    qtbot.addWidget(w)
+    w.resize(640, 480)
+    arm = scenes_dir() / "arm3d"
+    w.ctx.push(add_character3d_command(w.doc, arm / "arm.skel", arm / "arm.skin", asset_id="arm"))
+    w.ctx.set_frame(3.0)
+    w.show()
+    qtbot.waitExposed(w)
+    assert w.central_tabs.currentWidget() is not w.viewport_panel   # the 2D tab is shown
+    return w
+
+
+def _open_3d_tab(w, qtbot):
+    painted: list[float] = []
+    w.viewport3d.frameRendered.connect(painted.append)
+    w.central_tabs.setCurrentWidget(w.viewport_panel)
+    qtbot.waitUntil(lambda: w.viewport3d.gl.isExposed() and bool(painted), timeout=10000)
+    return w.viewport3d.render_image()
+
+
+def test_a_hidden_3d_view_prepares_its_gl_early_and_then_draws_the_same_picture(qtbot, monkeypatch):
+    """Shortly after the window shows, the hidden 3D view makes its context, programs and
+    meshes (so that opening the tab only draws); while hidden it asks for no pictures; once
+    opened it draws exactly what a view prepared the usual way (at its first show) draws."""
+    w = _window_with_hidden_3d(qtbot)
+    view = w.viewport3d
+    qtbot.waitUntil(lambda: view._prepare_state == "done", timeout=10000)
+    assert not view.gl.isExposed()
+    assert view.gl.context() is not None and view.renderer.initialized
+    painted: list[float] = []
+    view.frameRendered.connect(painted.append)
+    w.ctx.set_frame(4.0)
+    qtbot.wait(100)
+    assert painted == []          # hidden: nothing is drawn for it
+    prepared = _open_3d_tab(w, qtbot)
+
+    monkeypatch.setattr(viewport.Viewport3D, "PREPARE_PLATFORMS", ())
+    plain = _window_with_hidden_3d(qtbot)
+    plain.ctx.set_frame(4.0)
+    qtbot.wait(PREPARE_WAIT_MS)
+    assert plain.viewport3d._prepare_state == "" and plain.viewport3d.gl.context() is None
+    usual = _open_3d_tab(plain, qtbot)
+    assert prepared.shape == usual.shape
+    np.testing.assert_array_equal(prepared, usual)
+
+
+PREPARE_WAIT_MS = viewport.PREPARE_DELAY_MS + 200
