@@ -30,6 +30,7 @@ from qtanimator.document.simulation import (
     ui_idle,
 )
 from qtanimator.document.simulation import progress as simulation_progress
+from qtanimator.ui.key_selection import KeySelection
 from qtanimator.ui.undo import push_command, record_command
 
 #: The frame clock's period: views refresh at most once per 60 Hz frame during a gesture.
@@ -91,6 +92,8 @@ class EditorContext(QObject):
         self._frame = 0.0
         self._selection: tuple[str, str] = ("", "")
         self._channel_selection: list[str] = []
+        #: The selected keys, shared by the curve editor and the dope sheet.
+        self.key_selection = KeySelection(self)
         self._gestures: list[Gesture] = []
         self._pending: DocumentChange | None = None
         self._since_flush = QElapsedTimer()
@@ -194,6 +197,7 @@ class EditorContext(QObject):
         self._selection = ("", "")
         had_channels = bool(self._channel_selection)
         self._channel_selection = []
+        self.key_selection.clear()
         self.doc.replace_all(new)
         self.undo_stack.setClean()
         start, _end = self.doc.frame_range

@@ -46,7 +46,7 @@ from PySide6.QtWidgets import (
 
 from qtanimator.document.cloth_worker import LiveCloths, cloth_worker
 from qtanimator.document.document import DocumentChange
-from qtanimator.render.gl import surface_format
+from qtanimator.render.gl import surface_format, view_samples
 from qtanimator.render.gl.camera import OrbitCamera
 from qtanimator.render.gl.lights import LIGHT_NAMES, ambient_of, lights_of
 from qtanimator.render.gl.picking import pick_joint, ray_sphere
@@ -96,7 +96,7 @@ class _GLWidgetSurface(QOpenGLWidget):
     def __init__(self, view: Viewport3D) -> None:
         super().__init__(view)
         self.view = view
-        self.setFormat(surface_format())
+        self.setFormat(surface_format(view_samples()))
         self.setAttribute(Qt.WidgetAttribute.WA_TransparentForMouseEvents, True)
         self.setFocusPolicy(Qt.FocusPolicy.NoFocus)
 
@@ -115,7 +115,7 @@ class _GLWindowSurface(QOpenGLWindow):
     def __init__(self, view: Viewport3D) -> None:
         super().__init__(QOpenGLWindow.UpdateBehavior.NoPartialUpdate)
         self.view = view
-        self.setFormat(surface_format())
+        self.setFormat(surface_format(view_samples()))
 
     def initializeGL(self) -> None:
         self.view.initialize_gl()

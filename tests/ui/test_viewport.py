@@ -569,3 +569,19 @@ def test_a_hidden_3d_view_prepares_its_gl_early_and_then_draws_the_same_picture(
 
 
 PREPARE_WAIT_MS = viewport.PREPARE_DELAY_MS + 200
+
+
+def test_the_view_multisamples_on_a_gpu_but_not_on_a_software_rasteriser(window, monkeypatch):
+    """4× multisampling takes most of a frame on llvmpipe: the interactive view leaves it
+    out there (the renderer name decides), keeps it on a GPU, and obeys the override."""
+    from qtanimator.render import gl as glmod
+
+    view = window.viewport3d
+    software = glmod.is_software_renderer(view.gl_info or glmod.gl_renderer_name())
+    expected = 0 if software else glmod.VIEW_SAMPLES
+    assert glmod.view_samples() == expected
+    assert max(view.format().samples(), 0) == expected or (expected and view.format().samples() > 1)
+    assert glmod.is_software_renderer("llvmpipe (LLVM 15.0.6, 256 bits)")
+    assert not glmod.is_software_renderer("NVIDIA GeForce RTX 3060/PCIe/SSE2")
+    monkeypatch.setenv("QTANIMATOR_VIEW_SAMPLES", "8")
+    assert glmod.view_samples() == 8
