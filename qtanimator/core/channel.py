@@ -7,7 +7,10 @@ The semantics are fixed by ARCHITECTURE section 4 and notes/cse169-formats.md se
 * the span after key ``i`` is cubic Hermite with ``v0 = Δt·out[i]``, ``v1 = Δt·in[i+1]``,
   or linear, or constant (stepped);
 * before the first key and after the last one the pre / post extrapolation applies, with
-  strict boundaries and the floor convention at exact period multiples.
+  strict boundaries and the floor convention at exact period multiples;
+* a key may carry handle lengths (weighted tangents, issue 13): a cubic span with a weight
+  on either side is a cubic Bézier in time and value, evaluated exactly by solving for its
+  parameter (:mod:`qtanimator.core.bezier`); spans without weights are Hermite as above.
 
 A :class:`Channel` is an immutable value. Editing operations return a new channel, which
 keeps undo exact (a command stores the old and the new object) and lets caches key on
@@ -19,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import numbers
 from bisect import bisect_right
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field, replace
@@ -27,6 +31,8 @@ from typing import Any, overload
 
 import numpy as np
 import numpy.typing as npt
+
+from qtanimator.core import bezier
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -70,6 +76,18 @@ class Key:
 
     ``broken`` records whether the curve editor moves the in and out handles apart; it
     does not change evaluation.
+
+    ``in_weight`` / ``out_weight`` are handle lengths (Maya's weighted tangents, Blender's
+    Bézier handles): the extent of the in / out handle along the time axis, in seconds,
+    finite and positive. None (the default) is the Hermite span's handle, one third of the
+    span. A cubic span from key ``a`` to key ``b`` is *weighted* when ``a.out_weight`` or
+    ``b.in_weight`` is set; it is then the cubic Bézier with control points
+    ``(ta, va)``, ``(ta + wa, va + wa·sa)``, ``(tb − wb, vb − wb·sb)``, ``(tb, vb)``, where
+    ``sa`` / ``sb`` are the resolved out / in slopes (the tangent rules give the
+    direction, the weight the length) and a missing weight counts as ``Δt/3``. When
+    ``wa + wb > Δt`` evaluation scales both down in proportion so that they fill the span
+    (time stays monotonic, as Blender clamps); the key keeps the lengths the user set.
+    Weights on linear and stepped spans are kept but have no effect.
     """
 
     time: float
@@ -80,6 +98,8 @@ class Key:
     out_slope: float = 0.0
     interpolation: Interpolation = Interpolation.CUBIC
     broken: bool = False
+    in_weight: float | None = None
+    out_weight: float | None = None
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.time) and math.isfinite(self.value)):
@@ -90,6 +110,10 @@ class Key:
         object.__setattr__(self, "in_tangent", Tangent(self.in_tangent))
         object.__setattr__(self, "out_tangent", Tangent(self.out_tangent))
         object.__setattr__(self, "interpolation", Interpolation(self.interpolation))
+        if self.in_weight is not None:
+            object.__setattr__(self, "in_weight", _weight(self.in_weight))
+        if self.out_weight is not None:
+            object.__setattr__(self, "out_weight", _weight(self.out_weight))
 
     @classmethod
     def make(cls, time: float, value: float, tan_in: Tangent | str | float = Tangent.SMOOTH,
@@ -111,13 +135,28 @@ class Key:
             d["interp"] = self.interpolation.value
         if self.broken:
             d["broken"] = True
+        if self.in_weight is not None:
+            d["in_weight"] = self.in_weight
+        if self.out_weight is not None:
+            d["out_weight"] = self.out_weight
         return d
 
     @classmethod
     def from_dict(cls, d: dict[str, Any]) -> Key:
         return cls.make(d["t"], d["v"], d.get("in", "smooth"), d.get("out", "smooth"),
                         interpolation=Interpolation(d.get("interp", "cubic")),
-                        broken=bool(d.get("broken", False)))
+                        broken=bool(d.get("broken", False)),
+                        in_weight=d.get("in_weight"), out_weight=d.get("out_weight"))
+
+
+def _weight(w: Any) -> float:
+    """A handle length: a finite positive number of seconds (not a bool, not a text)."""
+    if isinstance(w, (bool, str, bytes)) or not isinstance(w, numbers.Real):
+        raise TypeError(f"a tangent weight must be a number of seconds, got {w!r}")
+    value = float(w)
+    if not (math.isfinite(value) and value > 0.0):
+        raise ValueError(f"a tangent weight must be finite and positive, got {w!r}")
+    return value
 
 
 def _rule_and_slope(tan: Tangent | str | float) -> tuple[Tangent, float]:
@@ -148,6 +187,13 @@ class _Compiled:
     value is exactly the last key's value and its first and second derivatives are those
     at the end of the last real span, so ``t == t_last`` needs no special case and a
     stepped last span ends on its key.
+
+    Weighted spans (see :class:`Key`) are Béziers instead: ``weighted`` marks them (None
+    when a channel has none, so an unweighted channel runs exactly the Hermite code), and
+    ``bez`` holds the forms ``(ax, bx, cx, ay, by, cy, y0, span)`` of
+    :mod:`qtanimator.core.bezier`, forward of span ``i`` at ``2·i`` and backward at
+    ``2·i + 1``, with x measured as ``rel`` measures it; ``bez_l`` the same per span as
+    plain floats, ``(forward, backward)``, or None for a Hermite span.
     """
 
     times: FloatArray
@@ -170,6 +216,12 @@ class _Compiled:
     rise: float  # p_last − p0, the cycle_offset step
     in0: float   # the first key's in slope (linear pre-extrapolation)
     out1: float  # the last key's out slope (linear post-extrapolation)
+    weighted: npt.NDArray[np.bool_] | None = None
+    bez: tuple[FloatArray, ...] = ()
+    bez_l: list[tuple[tuple[float, ...], tuple[float, ...]] | None] | None = None
+    # Handle extents (seconds) evaluation uses per span: out of its first key, into its last.
+    handle_out: FloatArray | None = None
+    handle_in: FloatArray | None = None
 
 
 @dataclass(frozen=True, eq=True)
@@ -255,6 +307,86 @@ class Channel:
         c = self._compile()
         return c.slope_in, c.slope_out
 
+    @property
+    def is_weighted(self) -> bool:
+        """True when some span is weighted (a cubic Bézier with handle lengths, see :class:`Key`)."""
+        if self._compiled:
+            return self._compiled[0].weighted is not None
+        return _weighted_spans(self.keys) is not None
+
+    def span_handles(self) -> tuple[npt.NDArray[np.bool_], FloatArray, FloatArray]:
+        """Per span (``len(keys) − 1`` entries): whether it is weighted, and the extents
+        along time (seconds) of its out handle (at its first key) and its in handle (at its
+        last key) as evaluation uses them: the key's weight or ``Δt/3``, clamped to the span.
+        The Bézier of span ``i`` has control points ``(t[i], v[i])``,
+        ``(t[i] + h_out[i], v[i] + h_out[i]·out[i])``, ``(t[i+1] − h_in[i], v[i+1] −
+        h_in[i]·in[i+1])``, ``(t[i+1], v[i+1])`` with the slopes of :meth:`slopes`."""
+        c = self._compile()
+        n = len(self.keys)
+        if n < 2:
+            return np.zeros(0, dtype=bool), np.zeros(0), np.zeros(0)
+        if c.weighted is None or c.handle_out is None or c.handle_in is None:
+            third = np.diff(c.rel) / 3.0
+            return np.zeros(n - 1, dtype=bool), third, third.copy()
+        return c.weighted[:-1].copy(), c.handle_out.copy(), c.handle_in.copy()
+
+    def unweighted(self, tolerance: float | None = None, max_keys: int = 4096) -> tuple[Channel, int, float]:
+        """An equivalent channel without weights, for formats that cannot hold them.
+
+        Each weighted span is cut in halves, and the halves in halves where needed, by keys
+        on the curve whose fixed slopes are its derivative there, until every Hermite piece
+        stays within ``tolerance`` of the Bézier (default ``1e-6 × max(1, largest
+        |value|)``; checked against half of it at 15 points per piece, a margin for the
+        points between) or the span has ``max_keys`` new keys. The keys at the ends of a
+        weighted span get fixed slopes (their resolved ones), since new neighbours would
+        change a rule; every other key, the extrapolation and the unweighted spans stay as
+        they are. Returns the channel, how many keys were added and the largest deviation
+        found. A channel without weighted spans is returned as it is.
+        """
+        c = self._compile()
+        if c.weighted is None:
+            return self, 0, 0.0
+        tol = tolerance if tolerance is not None else 1e-6 * max(1.0, float(np.max(np.abs(c.values))))
+        keys = [replace(k, in_weight=None, out_weight=None) for k in self.keys]
+        worst = 0.0
+        probe = np.arange(1, 16) / 16.0
+        for i in np.flatnonzero(c.weighted):
+            ta, tb = float(c.times[i]), float(c.times[i + 1])
+            for j in (i, i + 1):
+                keys[j] = replace(keys[j], in_tangent=Tangent.FIXED, out_tangent=Tangent.FIXED,
+                                  in_slope=float(c.slope_in[j]), out_slope=float(c.slope_out[j]))
+
+            def on_span(t: FloatArray, deriv: int, i: int = int(i), tb: float = tb) -> FloatArray:
+                # This span's own curve, also at its end (the channel gives the next span's there).
+                res: FloatArray = self.evaluate(t, deriv)
+                end = c.values[i + 1] if deriv == 0 else c.slope_in[i + 1]
+                return np.where(t == tb, end, res)
+
+            cuts: list[float] = []
+            pieces = np.array([[ta, tb]])
+            while pieces.size:
+                lo, hi = pieces[:, :1], pieces[:, 1:]
+                h = hi - lo
+                check = lo + h * probe
+                ends = np.concatenate([lo, hi], axis=1)
+                y, s = on_span(ends, 0), on_span(ends, 1)
+                err = np.max(np.abs(_hermite(y[:, :1], y[:, 1:], h * s[:, :1], h * s[:, 1:], probe)
+                                    - on_span(check, 0)), axis=1)
+                mid = (0.5 * (lo + hi))[:, 0]
+                split = (err > 0.5 * tol) & (lo[:, 0] < mid) & (mid < hi[:, 0])
+                if len(cuts) + int(split.sum()) > max_keys:
+                    split[:] = False
+                worst = max(worst, float(np.max(err[~split], initial=0.0)))
+                cuts += mid[split].tolist()
+                pieces = np.concatenate([np.column_stack([lo[split, 0], mid[split]]),
+                                         np.column_stack([mid[split], hi[split, 0]])])
+            if cuts:
+                t = np.array(sorted(cuts))
+                values, slopes = on_span(t, 0), on_span(t, 1)
+                keys += [Key(float(x), float(v), Tangent.FIXED, Tangent.FIXED, float(d), float(d))
+                         for x, v, d in zip(t, values, slopes)]
+        return Channel(keys, self.pre, self.post), len(keys) - len(self.keys), worst
+
     @overload
     def evaluate(self, t: float, derivative: int = 0) -> float: ...
     @overload
@@ -297,6 +429,8 @@ class Channel:
         period = c.period
         if 0.0 <= w <= period:
             i = bisect_right(c.rel_l, w) - 1
+            if c.bez_l is not None and (bz := c.bez_l[i]) is not None:
+                return _bezier(bz, w - c.rel_l[i], deriv)
             return _poly(c.coef_l[i], w - c.rel_l[i], deriv)
         if math.isnan(w):
             return math.nan
@@ -317,7 +451,10 @@ class Channel:
         if odd:
             u = period - u
         i = max(bisect_right(c.rel_l, u) - 1, 0)
-        res = _poly(c.coef_l[i], u - c.rel_l[i], deriv)
+        if c.bez_l is not None and (bz := c.bez_l[i]) is not None:
+            res = _bezier(bz, u - c.rel_l[i], deriv)
+        else:
+            res = _poly(c.coef_l[i], u - c.rel_l[i], deriv)
         if odd and deriv == 1:
             res = -res
         if mode is Extrapolation.CYCLE_OFFSET and deriv == 0:
@@ -339,7 +476,7 @@ class Channel:
             # Fast path: every sample lies between the first and the last key.
             i = np.searchsorted(c.rel, w, side="right")
             i -= 1
-            return _poly_array(c, i, w - c.rel.take(i), deriv)
+            return _span_array(c, i, w - c.rel.take(i), deriv)
         with np.errstate(invalid="ignore"):
             return self._extrapolate_array(c, t, w, deriv)
 
@@ -378,7 +515,7 @@ class Channel:
         # sort after every key, land in the sentinel and stay NaN all the way through.
         i = np.searchsorted(c.rel, u, side="right")
         i -= 1
-        res = _poly_array(c, i, u - c.rel.take(i), deriv)
+        res = _span_array(c, i, u - c.rel.take(i), deriv)
         if odd is not None and deriv == 1:
             np.negative(res, out=res, where=odd)
         if k is not None and deriv == 0:
@@ -438,6 +575,15 @@ class Channel:
         t0 = float(times[0]) if n else 0.0
         t1 = float(times[-1]) if n else 0.0
         rel = times - t0
+        weighted = _weighted_spans(keys) if n >= 2 else None
+        extra: dict[str, Any] = {}
+        if weighted is not None:
+            extra = _bezier_spans(weighted, rel, values, s_in, s_out, keys)
+            if weighted[-2]:
+                # The sentinel continues the last (Bézier) span's derivatives at its end.
+                fwd, bwd = extra["bez_l"][-2]
+                b[-1] = 0.5 * bezier.evaluate_span(fwd[7], fwd, bwd, 2)
+                c[-1] = bezier.evaluate_span(fwd[7], fwd, bwd, 1)
         comp = _Compiled(
             times, values, s_in, s_out, rel, a, b, c, d,
             rel.tolist(), list(zip(a.tolist(), b.tolist(), c.tolist(), d.tolist())),
@@ -445,6 +591,7 @@ class Channel:
             float(values[0]) if n else 0.0, float(values[-1]) if n else 0.0,
             float(values[-1] - values[0]) if n else 0.0,
             float(s_in[0]) if n else 0.0, float(s_out[-1]) if n else 0.0,
+            **extra,
         )
         self._compiled.append(comp)
         return comp
@@ -454,12 +601,15 @@ class Channel:
         """Plain JSON data: ``pre``, ``post`` and the keys.
 
         By default the keys are a list of objects ``{"t", "v", "in", "out"[, "interp"]
-        [, "broken"]}`` (project format 1; :meth:`Document.state` compares this form).
-        With ``columns`` they are columns (project format 2): ``times`` and ``values``
-        arrays, and ``in`` / ``out`` / ``interp`` / ``broken`` each written once when every
-        key shares it (an ``in`` rule name or fixed slope) and as one entry per key
-        otherwise; ``interp`` is left out when every span is cubic and ``broken`` when no
-        key is broken, as in the key form.
+        [, "broken"][, "in_weight"][, "out_weight"]}`` (project format 1;
+        :meth:`Document.state` compares this form). With ``columns`` they are columns
+        (project format 2): ``times`` and ``values`` arrays, and ``in`` / ``out`` /
+        ``interp`` / ``broken`` / ``in_weight`` / ``out_weight`` each written once when
+        every key shares it (an ``in`` rule name or fixed slope) and as one entry per key
+        otherwise; ``interp`` is left out when every span is cubic, ``broken`` when no key
+        is broken and a weight column when no key has that weight (a key without one is
+        ``null`` in a per-key column), as in the key form. So a channel without weights
+        writes exactly what it wrote before weights existed.
         """
         d: dict[str, Any] = {"pre": self.pre.value, "post": self.post.value}
         if not columns:
@@ -475,6 +625,10 @@ class Channel:
             broken = _shared([k.broken for k in keys])
             if broken is not False:
                 d["broken"] = broken
+            for side in ("in_weight", "out_weight"):
+                weights = [getattr(k, side) for k in keys]
+                if any(w is not None for w in weights):
+                    d[side] = _shared(weights)
         # Plain floats (a key made in code may hold an int): what loads back saves the same.
         d["times"] = [float(k.time) for k in keys]
         d["values"] = [float(k.value) for k in keys]
@@ -495,16 +649,24 @@ class Channel:
         n = len(times)
         if len(values) != n:
             raise ValueError(f"{n} times but {len(values)} values")
-        columns = {name: d.get(name, default) for name, default in
-                   (("in", "smooth"), ("out", "smooth"), ("interp", "cubic"), ("broken", False))}
+        columns: dict[str, Any] = {name: d.get(name, default) for name, default in
+                   (("in", "smooth"), ("out", "smooth"), ("interp", "cubic"), ("broken", False),
+                    ("in_weight", None), ("out_weight", None))}
         for name, column in columns.items():
             if isinstance(column, list) and len(column) != n:
                 raise ValueError(f"\"{name}\" has {len(column)} entries for {n} keys")
-        ins, outs, interps, brokens = columns.values()
+        ins, outs, interps, brokens, in_ws, out_ws = columns.values()
         if not all(isinstance(b, bool) for b in (brokens if isinstance(brokens, list) else [brokens])):
             raise TypeError("\"broken\" must be true or false")
         if not isinstance(brokens, list):
             brokens = itertools.repeat(brokens, n)
+        if in_ws is not None or out_ws is not None:
+            # Weights are rare: such a channel takes the per-key path.
+            ins, outs, interps, in_ws, out_ws = (c if isinstance(c, list) else itertools.repeat(c, n)
+                                                 for c in (ins, outs, interps, in_ws, out_ws))
+            return cls([Key.make(t, v, i, o, interpolation=Interpolation(m), broken=b, in_weight=iw, out_weight=ow)
+                        for t, v, i, o, m, b, iw, ow in zip(times, values, ins, outs, interps, brokens, in_ws, out_ws)],
+                       pre, post)
         if not any(isinstance(c, list) for c in (ins, outs, interps)):
             # Every key shares its rules: resolve them once (a long channel loads faster).
             in_rule, in_slope = _rule_and_slope(ins)
@@ -578,6 +740,63 @@ def _poly_array(comp: _Compiled, i: npt.NDArray[np.intp], x: FloatArray, deriv: 
     a *= x
     a += 2.0 * comp.b.take(i)
     return a
+
+
+def _hermite(p0: Any, p1: Any, v0: Any, v1: Any, u: Any) -> Any:
+    """The Hermite cubic with end values ``p0, p1`` and tangents ``v0, v1`` (per unit u)."""
+    u2 = u * u
+    u3 = u2 * u
+    return (2 * u3 - 3 * u2 + 1) * p0 + (u3 - 2 * u2 + u) * v0 + (-2 * u3 + 3 * u2) * p1 + (u3 - u2) * v1
+
+
+def _span_array(comp: _Compiled, i: npt.NDArray[np.intp], x: FloatArray, deriv: int) -> FloatArray:
+    """Evaluate span ``i`` at offset ``x``: the Hermite polynomial, then the Bézier spans
+    (only where the channel has any) in place of theirs."""
+    res = _poly_array(comp, i, x, deriv)
+    if comp.weighted is not None:
+        sel = np.flatnonzero(comp.weighted.take(i))
+        if sel.size:
+            res[sel] = bezier.evaluate_span_array(x.take(sel), comp.bez, i.take(sel), deriv)
+    return res
+
+
+def _bezier(forms: tuple[tuple[float, ...], tuple[float, ...]], x: float, deriv: int) -> float:
+    return bezier.evaluate_span(x, forms[0], forms[1], deriv)
+
+
+def _weighted_spans(keys: Sequence[Key]) -> npt.NDArray[np.bool_] | None:
+    """Per span (plus the sentinel, never weighted): a cubic span with a weight on either
+    side. None when there is none."""
+    if all(k.in_weight is None and k.out_weight is None for k in keys):
+        return None
+    mask = np.zeros(len(keys), dtype=bool)
+    for i, (ka, kb) in enumerate(zip(keys, keys[1:])):
+        mask[i] = ka.interpolation is Interpolation.CUBIC and (ka.out_weight is not None or kb.in_weight is not None)
+    return mask if mask.any() else None
+
+
+def _bezier_spans(weighted: npt.NDArray[np.bool_], rel: FloatArray, values: FloatArray, s_in: FloatArray,
+                  s_out: FloatArray, keys: Sequence[Key]) -> dict[str, Any]:
+    """The Bézier data of :class:`_Compiled` for a channel with weighted spans."""
+    n = len(keys)
+    span = np.diff(rel)  # as the evaluation measures offsets into a span
+    third = span / 3.0
+    wa = np.array([third[i] if k.out_weight is None else k.out_weight for i, k in enumerate(keys[:-1])])
+    wb = np.array([third[i] if k.in_weight is None else k.in_weight for i, k in enumerate(keys[1:])])
+    wa, wb = bezier.effective_weights(span, wa, wb)
+    # Unweighted spans keep their exact third (they are drawn and evaluated as Hermite).
+    w = weighted[:-1]
+    wa = np.where(w, wa, third)
+    wb = np.where(w, wb, third)
+    forward, backward = bezier.span_forms(span, wa, wb, np.diff(values), s_out[:-1], s_in[1:], values[:-1])
+    # Interleaved (forward of span i at 2i, backward at 2i + 1), plus the sentinel's pair.
+    bez = tuple(np.append(np.column_stack([f, b]).reshape(-1), [0.0, 0.0]) for f, b in zip(forward, backward))
+    fwd_rows = list(zip(*(arr.tolist() for arr in forward)))
+    bwd_rows = list(zip(*(arr.tolist() for arr in backward)))
+    bez_l: list[tuple[tuple[float, ...], tuple[float, ...]] | None] = [
+        (fwd_rows[i], bwd_rows[i]) if weighted[i] else None for i in range(n - 1)]
+    bez_l.append(None)
+    return {"weighted": weighted, "bez": bez, "bez_l": bez_l, "handle_out": wa, "handle_in": wb}
 
 
 def _resolve_slopes(keys: Sequence[Key], times: FloatArray,

@@ -9,6 +9,10 @@ property ``index`` = which character of a folder). Channels:
   angle θ and sets the simulation's state at its keys (θ from the key, ω = 0), so the
   animator can pose a pendulum's starting angle. Between keys physics drives it.
 
+With auto-key off, posing writes no key: the values are the document's *pending pose*
+(:mod:`qtanimator.document.pose`), which every evaluation here shows at its time (a
+dynamic joint's pending value is its world angle) until the frame changes or it is keyed.
+
 Keys use smooth tangents with constant extrapolation, which is the reference program's
 Catmull-Rom spline. Per-joint keys by default; with the parameter ``animation.key_all``
 true an edit sets the reference program's universal keyframe (every joint of every 2D
@@ -39,6 +43,7 @@ from qtanimator.core.pendulum import PRESETS, PendulumBlowUp, PendulumParams, Pe
 from qtanimator.core.rig2d import Character, Pose
 from qtanimator.document.commands import AddAsset, Command, DeleteKeys, Macro, SetKeys, SetParameter
 from qtanimator.document.document import Asset, Document, DocumentChange, channel_id, split_channel_id
+from qtanimator.document.pose import pending_value, pending_values
 from qtanimator.document.simulation import SimulationWorker, ui_idle
 
 ASSET_KIND = "character2d"
@@ -130,6 +135,10 @@ def position_channel_ids(asset_id: str) -> tuple[str, str]:
 
 
 def _value(doc: Document, cid: str, time: float, derivative: int = 0) -> float:
+    if derivative == 0:
+        held = pending_value(doc, cid, time)  # an unkeyed pose shown at this time
+        if held is not None:
+            return held
     ch = doc.channels.get(cid)
     return 0.0 if ch is None or not ch.keys else float(ch.evaluate(time, derivative))
 
@@ -165,6 +174,13 @@ def joint_angles(doc: Document, asset_id: str, time: float, block: bool = True) 
     angles = keyframed_angles(doc, asset_id, time)
     if ch.dynamic.any():
         world = simulation(doc).world_angles(asset_id, time, wait=block)
+        held = pending_values(doc, time)
+        if held:  # a pendulum posed without a key shows its posed world angle
+            world = np.array(world, dtype=np.float64)
+            for k in np.flatnonzero(ch.dynamic):
+                v = held.get(angle_channel_id(asset_id, ch.joints[int(k)].name))
+                if v is not None:
+                    world[k] = v
         angles = _local_from_world_dynamic(ch, angles, world)
     return angles
 
@@ -202,19 +218,22 @@ def _key_all_values(doc: Document, time: float) -> dict[str, Key]:
     return keys
 
 
-def _set_keys(doc: Document, keys: dict[str, Key], text: str, gesture: Hashable | None) -> Command:
-    if bool(doc.parameter(KEY_ALL_PARAMETER, False)):
-        time = next(iter(keys.values())).time
+def key_values(doc: Document, values: dict[str, float], time: float, text: str,
+               gesture: Hashable | None = None) -> Command:
+    """Key channel ``values`` at ``time`` — the one place a 2D edit becomes keys. With
+    key-all (``animation.key_all``) the edit sets the universal keyframe: every keyframed
+    joint and position of every 2D character keyed at ``time`` as well."""
+    keys = {cid: _key(time, v) for cid, v in values.items()}
+    if keys and bool(doc.parameter(KEY_ALL_PARAMETER, False)):
         merged = _key_all_values(doc, time)
         merged.update(keys)
         keys = merged
     return SetKeys(doc, keys, text=text, gesture=gesture)
 
 
-def key_joint(doc: Document, asset_id: str, joint_index: int, angle: float, time: float,
-              gesture: Hashable | None = None) -> Command:
-    """Key a joint's local ``angle`` at ``time``. For a dynamic joint the key holds the
-    matching world angle and restarts the pendulum there."""
+def joint_value(doc: Document, asset_id: str, joint_index: int, angle: float, time: float) -> dict[str, float]:
+    """The channel value that poses a joint at local ``angle`` (a dynamic joint's channel
+    holds the matching world angle)."""
     ch = character(doc, asset_id)
     j = ch.joints[joint_index]
     value = float(angle)
@@ -223,23 +242,35 @@ def key_joint(doc: Document, asset_id: str, joint_index: int, angle: float, time
         exact = bool(ch.dynamic[ch.ancestors(j.parent)].any())
         angles = joint_angles(doc, asset_id, time) if exact else keyframed_angles(doc, asset_id, time)
         value = float(ch.pose(angles).world_angles[j.parent]) + value
-    return _set_keys(doc, {angle_channel_id(asset_id, j.name): _key(time, value)},
-                     f"Rotate {j.name}", gesture)
+    return {angle_channel_id(asset_id, j.name): value}
+
+
+def key_joint(doc: Document, asset_id: str, joint_index: int, angle: float, time: float,
+              gesture: Hashable | None = None) -> Command:
+    """Key a joint's local ``angle`` at ``time``. For a dynamic joint the key holds the
+    matching world angle and restarts the pendulum there."""
+    name = character(doc, asset_id).joints[joint_index].name
+    return key_values(doc, joint_value(doc, asset_id, joint_index, angle, time), time, f"Rotate {name}", gesture)
+
+
+def position_values(asset_id: str, xy: npt.ArrayLike) -> dict[str, float]:
+    """The channel values that put the character at offset ``xy`` from its rest pose."""
+    x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(2))
+    cx, cy = position_channel_ids(asset_id)
+    return {cx: x, cy: y}
 
 
 def move_character(doc: Document, asset_id: str, xy: npt.ArrayLike, time: float,
                    gesture: Hashable | None = None) -> Command:
     """Key the character's translation (offset from the rest pose) to ``xy`` at ``time``."""
-    x, y = (float(v) for v in np.asarray(xy, dtype=np.float64).reshape(2))
-    cx, cy = position_channel_ids(asset_id)
-    return _set_keys(doc, {cx: _key(time, x), cy: _key(time, y)}, f"Move {asset_id}", gesture)
+    return key_values(doc, position_values(asset_id, xy), time, f"Move {asset_id}", gesture)
 
 
-def ik_drag(doc: Document, asset_id: str, joint_index: int, local_point: npt.ArrayLike,
-            target: npt.ArrayLike, time: float, gesture: Hashable | None = None,
-            limits: npt.ArrayLike | None = None) -> Command:
-    """Solve IK from the pose at ``time`` with the document's IK settings (``IK_DEFAULTS``)
-    and key the keyframed joints that moved (every joint in key-all mode)."""
+def ik_values(doc: Document, asset_id: str, joint_index: int, local_point: npt.ArrayLike,
+              target: npt.ArrayLike, time: float, limits: npt.ArrayLike | None = None) -> dict[str, float]:
+    """Solve IK from the pose shown at ``time`` with the document's IK settings
+    (``IK_DEFAULTS``): the new angles of the keyframed joints that moved, by channel.
+    Every IK path (a drag that keys, one that only poses) gets its values here."""
     ch = character(doc, asset_id)
     if ch.dynamic[ch.ancestors(joint_index)].any():
         before = joint_angles(doc, asset_id, time)
@@ -256,12 +287,18 @@ def ik_drag(doc: Document, asset_id: str, joint_index: int, local_point: npt.Arr
                          freeze_root=bool(ik_setting(doc, "ik.freeze_root")),
                          max_iterations=int(ik_setting(doc, "ik.max_iterations")),
                          damping=float(ik_setting(doc, "ik.damping")))
-    keys = {angle_channel_id(asset_id, j.name): _key(time, after[k])
+    return {angle_channel_id(asset_id, j.name): float(after[k])
             for k, j in enumerate(ch.joints)
             if not j.is_dynamic and abs(after[k] - before[k]) > 1e-12}
-    if not keys:
-        return SetKeys(doc, {}, text="IK drag", gesture=gesture)
-    return _set_keys(doc, keys, "IK drag", gesture)
+
+
+def ik_drag(doc: Document, asset_id: str, joint_index: int, local_point: npt.ArrayLike,
+            target: npt.ArrayLike, time: float, gesture: Hashable | None = None,
+            limits: npt.ArrayLike | None = None) -> Command:
+    """The keys of an IK drag, whatever the solver settings: the joints :func:`ik_values`
+    moved, through :func:`key_values` (every joint in key-all mode)."""
+    values = ik_values(doc, asset_id, joint_index, local_point, target, time, limits)
+    return key_values(doc, values, time, "IK drag", gesture)
 
 
 def delete_keys_at(doc: Document, asset_id: str | None, time: float) -> Command | None:

@@ -41,6 +41,7 @@ from qtanimator.core.skinning import (
 )
 from qtanimator.document.commands import AddAsset, Command, Macro, SetAssetProperty, SetChannels, SetKeys
 from qtanimator.document.document import Asset, Document, channel_id
+from qtanimator.document.pose import pending_values
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.attach import load_attach
 from qtanimator.formats.bvh import load_bvh
@@ -57,7 +58,7 @@ JOINT_DOFS = ("rx", "ry", "rz")
 
 __all__ = [
     "ASSET_KIND", "Character3D", "add_character3d_command", "channel_dofs", "channel_ids", "character",
-    "clip_from_document", "dof_channel_id", "load_bvh_character",
+    "clip_from_document", "dof_channel_id", "dof_values", "ik_values", "load_bvh_character",
     "load_anim_command", "load_character3d", "load_character3d_asset", "pose_skeleton", "set_dof_command",
     "set_dofs_command", "skinned_mesh", "world_matrices",
 ]
@@ -262,15 +263,32 @@ def set_dof_command(doc: Document, asset_id: str, joint_index: int | None, axis:
     return set_dofs_command(doc, asset_id, {(joint_index, axis): value}, time, gesture)
 
 
+def dof_values(doc: Document, asset_id: str,
+               values: Mapping[tuple[int | None, str | int], float]) -> dict[str, float]:
+    """Channel values for DOF values: ``values`` maps (joint, axis) to a value, clamped
+    to the DOF's limits. What a key or an unkeyed pose of those DOFs holds."""
+    return {dof_channel_id(doc, asset_id, joint, axis): _clamped(doc, asset_id, joint, axis, v)
+            for (joint, axis), v in values.items()}
+
+
 def set_dofs_command(doc: Document, asset_id: str, values: Mapping[tuple[int | None, str | int], float],
                      time: float, gesture: Hashable | None = None) -> Command:
     """Key several DOFs at ``time`` in one undo step; ``values`` maps (joint, axis) to a value."""
-    keys: dict[str, Key] = {}
-    for (joint, axis), v in values.items():
-        cid = dof_channel_id(doc, asset_id, joint, axis)
-        keys[cid] = Key(float(time), _clamped(doc, asset_id, joint, axis, v))
+    keys = {cid: Key(float(time), v) for cid, v in dof_values(doc, asset_id, values).items()}
     text = "Set Joint" if len(keys) == 1 else "Set Pose"
     return SetKeys(doc, keys, text=text, gesture=gesture)
+
+
+def ik_values(doc: Document, asset_id: str, joint: int, target: npt.ArrayLike, time: float,
+              dofs: list[tuple[int, int]]) -> dict[tuple[int | None, str | int], float]:
+    """Solve IK for ``joint`` towards ``target`` over ``dofs`` from the pose shown at
+    ``time``: the new DOF values by (joint, axis). Both 3D IK paths (keying and posing
+    without keys) get their values here."""
+    from qtanimator.core.ik3d import solve_ik
+
+    skel = pose_skeleton(doc, asset_id, time)
+    result = solve_ik(skel, joint, np.asarray(target, dtype=np.float64), dofs=dofs)
+    return {(j, axis): v for (j, axis), v in result.by_axis_name().items()}
 
 
 def clip_from_document(doc: Document, asset_id: str, start: float | None = None,
@@ -294,16 +312,20 @@ def clip_from_document(doc: Document, asset_id: str, start: float | None = None,
 
 # -------------------------------------------------------------------- evaluation
 def pose_skeleton(doc: Document, asset_id: str, time: float) -> Skeleton:
-    """A posed copy of the character's skeleton at ``time`` (channel values clamped)."""
+    """A posed copy of the character's skeleton at ``time`` (channel values clamped; a
+    pending, unkeyed pose at ``time`` is shown: see :mod:`qtanimator.document.pose`)."""
     ch = character(doc, asset_id)
     skel = ch.skeleton.copy()
     ids = _channel_ids(asset_id, skel.joint_keys())
     t = float(time)
+    held = pending_values(doc, t)  # an unkeyed pose shown at this time (document.pose)
     for i, cid in enumerate(ids):
-        channel = doc.channels.get(cid)
-        if channel is None or not channel.keys:
-            continue
-        v = channel.evaluate(t)
+        v = held.get(cid) if held else None
+        if v is None:
+            channel = doc.channels.get(cid)
+            if channel is None or not channel.keys:
+                continue
+            v = channel.evaluate(t)
         if i < 3:
             skel.root_translation[i] = v
         else:

@@ -20,11 +20,17 @@ line endings (LF, CRLF, ``\\r\\r\\n``, bare CR) are accepted. ``numchannels`` ma
 missing or misplaced; when present it must match the number of channels read.
 Tangents are ``flat | linear | smooth`` or a fixed slope (value per second); ``clamped``
 (qtanimator's own rule) is accepted and written too.
+
+The format has no handle lengths: a channel with weighted tangents (issue 13) is written
+as its :meth:`~qtanimator.core.channel.Channel.unweighted` equivalent (keys added on each
+weighted span, with fixed slopes, until the curve is followed to 1e-6 of its largest
+value), and :func:`format_anim` says so with an :class:`AnimExportWarning`.
 """
 
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -34,7 +40,11 @@ from qtanimator.formats._tokens import Tokens, read_text, show
 from qtanimator.formats.atomic import write_text_atomic
 from qtanimator.formats.errors import FormatError
 
-__all__ = ["AnimationClip", "load_anim", "parse_anim", "save_anim", "format_anim", "summarize"]
+__all__ = ["AnimExportWarning", "AnimationClip", "load_anim", "parse_anim", "save_anim", "format_anim", "summarize"]
+
+class AnimExportWarning(UserWarning):
+    """Writing changed what a channel holds (weighted tangents became added keys)."""
+
 
 _EXTRAPOLATIONS = {e.value for e in Extrapolation}
 _RULES = {"flat", "linear", "smooth", "clamped"}
@@ -183,12 +193,20 @@ def _tangent_text(rule: Tangent, slope: float) -> str:
 
 
 def format_anim(clip: AnimationClip) -> str:
-    """The clip as ``.anim`` text (numbers written exactly: load gives the same floats)."""
+    """The clip as ``.anim`` text (numbers written exactly: load gives the same floats).
+
+    A channel with weighted tangents is converted to keys without weights, with an
+    :class:`AnimExportWarning` per channel that says how many keys were added.
+    """
     out = ["animation {", f"\trange {_num(clip.start)} {_num(clip.end)}",
            f"\tnumchannels {len(clip.channels)}"]
     for i, ch in enumerate(clip.channels):
         if any(k.interpolation is not Interpolation.CUBIC for k in ch.keys):
             raise ValueError(f"channel {i} has linear or stepped spans, which .anim files cannot store")
+        if ch.is_weighted:
+            ch, added, worst = ch.unweighted()
+            warnings.warn(f"channel {i} has weighted tangents, which .anim files cannot hold: written with "
+                          f"{added} added keys (within {worst:.1g} of the curve).", AnimExportWarning, stacklevel=2)
         out.append(f"\tchannel {i} {{")
         out.append(f"\t\textrapolate {ch.pre.value} {ch.post.value}")
         out.append(f"\t\tkeys {len(ch.keys)} {{")

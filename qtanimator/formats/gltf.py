@@ -17,7 +17,9 @@ and the BIN chunk with zeros). :func:`export_character_glb` turns a
 inverse bind matrices, each vertex keeps its strongest four influences (renormalised, with a
 :class:`GltfExportWarning` when that visibly changes the animated shape), and the animation
 is sampled at ``fps`` with LINEAR or CUBICSPLINE interpolation. Exported time 0 is the
-clip's ``start``.
+clip's ``start``. glTF's cubic spline is Hermite and has no handle lengths, so a channel
+with weighted tangents (issue 13) is sampled like every other one, and a
+:class:`GltfExportWarning` names it.
 
 Every malformed file raises :class:`~qtanimator.formats.FormatError`.
 """
@@ -1343,6 +1345,14 @@ def _channel_values(skeleton: Skeleton, channels: Sequence[Channel | None], time
     return out
 
 
+def _channel_label(skeleton: Skeleton, index: int) -> str:
+    """``root translation x`` or ``<joint> x rotation`` for an ``.anim``-layout channel."""
+    if index < 3:
+        return f"root translation {'xyz'[index]}"
+    joint, axis = divmod(index - 3, 3)
+    return f"{skeleton.joints[joint].name} {'xyz'[axis]} rotation"
+
+
 def _top_influences(binding: SkinBinding, k: int) -> tuple[IntArray, FloatArray, IntArray]:
     """(V, k) strongest joints and renormalised weights, and the vertices that lost some."""
     pidx, pw = binding.padded(np.float64)
@@ -1401,6 +1411,10 @@ def build_character_scene(skeleton: Skeleton, skin_or_mesh_with_weights: Any,
     if skin.num_joints < nj and skin.binding.num_joints > skin.num_joints:
         raise ValueError("the skin has fewer bind matrices than the skeleton has joints")
     times = _sample_times(start, end, fps)
+    for i, chan in enumerate(chans[: 3 + 3 * nj]):
+        if chan is not None and chan.is_weighted:
+            warnings.warn(f"{name}: channel {i} ({_channel_label(skeleton, i)}) has weighted tangents, which glTF "
+                          f"cannot hold: sampled at {fps:g} fps ({interpolation}).", GltfExportWarning, stacklevel=3)
     if key_times:
         times = _with_key_times(times, [c for c in chans[: 3 + 3 * nj] if c is not None], start, end)
     lo, hi = skeleton.dof_limits()

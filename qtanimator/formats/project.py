@@ -23,9 +23,12 @@
 A channel's keys are columns (version 2): ``times`` and ``values``, and the tangent rules
 ``in`` / ``out`` (a rule name or a fixed slope), the span shape ``interp`` (left out when
 cubic) and ``broken`` (left out when false), each written once when every key shares it
-and as one entry per key otherwise. Number columns are written :data:`NUMBERS_PER_LINE` to
-a line. Version 1 wrote one object per key, ``"keys": [{"t": 0.0, "v": 0.5, "in":
-"smooth", "out": "smooth"}, ...]``; that form is still read.
+and as one entry per key otherwise. Handle lengths of weighted tangents (issue 13) are the
+columns ``in_weight`` / ``out_weight`` (seconds; ``null`` for a key without one), written
+only when some key of the channel has one, so a project without weights is written exactly
+as before. Number columns are written :data:`NUMBERS_PER_LINE` to a line. Version 1 wrote
+one object per key, ``"keys": [{"t": 0.0, "v": 0.5, "in": "smooth", "out": "smooth"},
+...]``; that form is still read.
 
 Asset ``source`` paths and asset properties whose name ends in ``_file`` are stored
 relative to the project file and made absolute on load. This module knows the schema only;

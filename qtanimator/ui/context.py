@@ -21,6 +21,7 @@ from PySide6.QtGui import QUndoStack
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, DocumentChange
 from qtanimator.document.gesture import Gesture
+from qtanimator.document.pose import clear_pending
 from qtanimator.document.simulation import (
     ensure_caches,
     pause_workers,
@@ -219,6 +220,8 @@ class EditorContext(QObject):
     def set_frame(self, frame: float) -> None:
         if frame != self._frame:
             self._frame = float(frame)
+            # An unkeyed pose (auto-key off) lasts until the frame changes.
+            clear_pending(self.doc)
             self.frameChanged.emit(self._frame)
 
     # -------------------------------------------------------------- selection

@@ -10,6 +10,14 @@ Mouse (the reference animator's, plus a view you can move):
   at once, the release records one undo step, Escape takes the drag back exactly;
 * middle-drag pans, the wheel zooms about the cursor, F fits the scene in the view.
 
+Auto-key (the timeline's record button, ``document.pose``): on, every drag keys; off, a
+drag only poses — the unkeyed pose is shown until the frame changes or it is keyed (the
+editor says so in its corner). S or I keys the selected joint (the character selected:
+its root and position), Shift+S every joint of the character. Ctrl+C copies the selected
+joint's pose (the whole character's when the character — its root — is selected), Ctrl+V
+pastes it as keys at the current frame, Ctrl+Shift+V pastes it mirrored (left/right
+joints swap; see ``document.pose.mirrored_value``). Each is one undo step.
+
 Keys: Delete / Backspace delete the keys at the current frame; ``d`` toggles the debug
 overlays (the character's path with velocity (blue) and acceleration (red) arrows at its
 keys, the IK source (red) / target (blue) dots and gradient arrows, and the HUD).
@@ -57,6 +65,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from qtanimator.document import pose as pose_doc
 from qtanimator.document.commands import Command
 from qtanimator.document.document import DocumentChange
 from qtanimator.document.gesture import Gesture
@@ -288,6 +297,7 @@ class RigEditorView(QGraphicsView):
 
     def _on_frame(self, _frame: float) -> None:
         self._poses = None
+        pose_doc.clear_pending(self.ctx.doc)  # an unkeyed pose lasts until the frame changes
         self.viewport().update()
 
     def _on_document(self, change: DocumentChange) -> None:
@@ -412,14 +422,15 @@ class RigEditorView(QGraphicsView):
                 return
             asset, joint = hit
             character = self.ctx.doc.runtime[asset]
+            autokey = pose_doc.autokey(self.ctx.doc)
             if joint == 0:
                 self.ctx.select(asset, "")
                 self._gesture = self._new_gesture(f"Move {asset}")
-                self._drag = ri.move_drag(self.ctx.doc, asset, point, time)
+                self._drag = ri.move_drag(self.ctx.doc, asset, point, time, autokey)
             else:
                 self.ctx.select(asset, character.joints[joint].name)
                 self._gesture = self._new_gesture(f"Rotate {character.joints[joint].name}")
-                self._drag = ri.rotate_drag(self.ctx.doc, asset, joint, point, time)
+                self._drag = ri.rotate_drag(self.ctx.doc, asset, joint, point, time, autokey)
             next(self._drag)
             self._drag_button = button
             event.accept()
@@ -432,7 +443,7 @@ class RigEditorView(QGraphicsView):
             character = self.ctx.doc.runtime[asset]
             self.ctx.select(asset, character.joints[joint].name if joint else "")
             self._gesture = self._new_gesture("IK Drag")
-            self._drag = ri.ik_drag(self.ctx.doc, asset, joint, point, time)
+            self._drag = ri.ik_drag(self.ctx.doc, asset, joint, point, time, pose_doc.autokey(self.ctx.doc))
             next(self._drag)
             self._ik = (asset, joint, ri.ik_source(self.ctx.doc, asset, joint, point, time))
             self._ik_target = point
@@ -541,6 +552,47 @@ class RigEditorView(QGraphicsView):
             return
         super().keyPressEvent(event)
 
+    # ------------------------------------------------------ set key, copy, paste
+    def _say(self, text: str) -> None:
+        window = self.window()
+        bar = getattr(window, "statusBar", None)
+        if callable(bar):
+            bar().showMessage(text, 4000)
+
+    def set_key(self, whole_character: bool = False) -> bool:
+        """S / I (``whole_character`` False) or Shift+S: key the shown pose of the
+        selected joint or of the whole selected character at the current frame."""
+        if self._drag is not None:
+            return False
+        command = ri.set_key_command(self.ctx.doc, self.ctx.selection, self.ctx.time, whole_character)
+        if command is None:
+            self._say("Select a joint or a character to key.")
+            return False
+        self.ctx.push(command)
+        return True
+
+    def copy_pose(self) -> bool:
+        """Ctrl+C: copy the selected joint's pose (the whole character's when it is selected)."""
+        clip = ri.copy_selection(self.ctx.doc, self.ctx.selection, self.ctx.time)
+        if clip is None:
+            self._say("Select a joint or a character to copy its pose.")
+            return False
+        ri.pose_clipboard.clip = clip
+        self._say(f"Copied the pose of {len(clip.values)} joint{'s' if len(clip.values) != 1 else ''}.")
+        return True
+
+    def paste_pose(self, mirrored: bool = False) -> bool:
+        """Ctrl+V / Ctrl+Shift+V: key the copied pose (mirrored) at the current frame."""
+        if self._drag is not None:
+            return False
+        command = ri.paste_command(self.ctx.doc, ri.pose_clipboard.clip, self.ctx.selection, self.ctx.time,
+                                   mirrored)
+        if command is None:
+            self._say("Nothing to paste here: copy a pose of a character like this one first.")
+            return False
+        self.ctx.push(command)
+        return True
+
     def delete_keys(self) -> None:
         """Delete / Backspace: remove the keys at the current frame from every character."""
         if self._drag is not None:
@@ -582,6 +634,8 @@ class RigEditorView(QGraphicsView):
 
     def drawForeground(self, painter: QPainter, rect: QRectF) -> None:
         self.frames_drawn += 1
+        if pose_doc.has_pending(self.ctx.doc, self.ctx.time):
+            self._draw_unkeyed_note(painter)
         if not self.debug:
             return
         ids = self.character_ids()
@@ -590,6 +644,21 @@ class RigEditorView(QGraphicsView):
         self._draw_paths(painter, ids)
         self._draw_ik(painter)
         self._draw_hud(painter)
+
+    def _draw_unkeyed_note(self, painter: QPainter) -> None:
+        """Auto-key off: say that the pose shown is not keyed yet."""
+        painter.save()
+        painter.resetTransform()
+        text = "Unkeyed pose: S keys the joint, Shift+S the character; another frame discards it"
+        fm = QFontMetricsF(painter.font())
+        box = QRectF(8, self.viewport().height() - fm.height() - 14, fm.horizontalAdvance(text) + 16,
+                     fm.height() + 8)
+        painter.setOpacity(0.85)
+        painter.fillRect(box, QColor(160, 20, 20))
+        painter.setOpacity(1.0)
+        painter.setPen(QColor(255, 255, 255))
+        painter.drawText(box, Qt.AlignmentFlag.AlignCenter, text)
+        painter.restore()
 
     def _cosmetic(self, color: QColor, width: float) -> QPen:
         pen = QPen(color, width)
@@ -727,6 +796,7 @@ class RigEditor(QWidget):
         self.toolbar.addAction(self.fit_action)
         self.toolbar.addAction(self.debug_action)
         self.addAction(self.fit_action)
+        self.pose_actions = self._pose_actions()
 
         self.toolbar.addSeparator()
         self.onion_box = QCheckBox("Onion skin", self)
@@ -749,6 +819,34 @@ class RigEditor(QWidget):
                                       "(the reference animator's IK)")
         self.ik_toggle_box.toggled.connect(lambda on: setattr(view, "ik_toggle_mode", on))
         self.toolbar.addWidget(self.ik_toggle_box)
+
+    def _pose_actions(self) -> dict[str, QAction]:
+        """Set key, key the character, copy / paste / paste mirrored pose: shortcuts of the
+        view only (other editors bind Ctrl+C / Ctrl+V to their keys)."""
+        view = self.view
+        specs = (
+            ("actionSetKey", "Set Key", ["S", "I"], lambda: view.set_key(False),
+             "Key the selected joint (the character selected: its root and position) at this frame"),
+            ("actionSetKeyCharacter", "Set Key on Whole Character", ["Shift+S"], lambda: view.set_key(True),
+             "Key every joint of the selected character at this frame"),
+            ("actionCopyPose", "Copy Pose", ["Ctrl+C"], view.copy_pose,
+             "Copy the selected joint's pose (the whole character's when the character is selected)"),
+            ("actionPastePose", "Paste Pose", ["Ctrl+V"], lambda: view.paste_pose(False),
+             "Key the copied pose at this frame"),
+            ("actionPasteMirrored", "Paste Pose Mirrored", ["Ctrl+Shift+V"], lambda: view.paste_pose(True),
+             "Key the copied pose at this frame with left and right swapped"),
+        )
+        actions: dict[str, QAction] = {}
+        for name, text, keys, slot, tip in specs:
+            action = QAction(text, self)
+            action.setObjectName(name)
+            action.setShortcuts([QKeySequence(k) for k in keys])
+            action.setShortcutContext(Qt.ShortcutContext.WidgetWithChildrenShortcut)
+            action.setToolTip(f"{tip} ({', '.join(keys)})")
+            action.triggered.connect(lambda _c=False, fn=slot: fn())
+            view.addAction(action)
+            actions[name] = action
+        return actions
 
     def _spin(self, name: str, label: str, lo: int, hi: int, value: int) -> QSpinBox:
         self.toolbar.addWidget(QLabel(f" {label} ", self))
@@ -820,6 +918,9 @@ def install(window: MainWindow) -> None:
     delete.setToolTip("Delete / Backspace in the 2D editor")
     delete.triggered.connect(lambda _c=False: editor.view.delete_keys())
     window.edit_menu.addAction(delete)
+    window.edit_menu.addSeparator()
+    for action in editor.pose_actions.values():
+        window.edit_menu.addAction(action)
     _restore_editor_settings(editor)
 
 

@@ -20,6 +20,7 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.document import character2d as c2d
+from qtanimator.document import pose
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, channel_id
 
@@ -61,37 +62,55 @@ def rotation_delta(pivot: Sequence[float], press: Sequence[float], cursor: Seque
 
 
 # ------------------------------------------------------------------------ drags
-def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> Drag:
+def pose_edit(doc: Document, values: dict[str, float], time: float, text: str, autokey: bool) -> Command:
+    """What a drag does with new channel values: key them (auto-key on, key-all
+    respected) or only show them as the pending, unkeyed pose (auto-key off)."""
+    if autokey:
+        return c2d.key_values(doc, values, time, text)
+    return pose.PosePreview(doc, values, time, text)
+
+
+def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float,
+                autokey: bool = True) -> Drag:
     """Left-drag on a joint: rotate it about its pivot following the cursor (from the pose
     the editor shows)."""
-    pose = c2d.evaluate_pose(doc, asset, time, block=False)
-    pivot = pose.pivots[joint].copy()
+    shown = c2d.evaluate_pose(doc, asset, time, block=False)
+    pivot = shown.pivots[joint].copy()
     start = float(np.asarray(c2d.joint_angles(doc, asset, time, block=False))[joint])
+    name = doc.runtime[asset].joints[joint].name
     cursor = yield None
     while True:
         angle = start + rotation_delta(pivot, press, cursor)
-        cursor = yield c2d.key_joint(doc, asset, joint, angle, time)
+        values = c2d.joint_value(doc, asset, joint, angle, time)
+        cursor = yield pose_edit(doc, values, time, f"Rotate {name}", autokey)
 
 
-def move_drag(doc: Document, asset: str, press: Sequence[float], time: float) -> Drag:
+def move_drag(doc: Document, asset: str, press: Sequence[float], time: float, autokey: bool = True) -> Drag:
     """Left-drag on a root joint: move the character (a position key at ``time``)."""
     start = np.asarray(c2d.translation(doc, asset, time), dtype=np.float64).copy()
     p0 = np.asarray(press, dtype=np.float64)
     cursor = yield None
     while True:
         xy = start + (np.asarray(cursor, dtype=np.float64) - p0)
-        cursor = yield c2d.move_character(doc, asset, (float(xy[0]), float(xy[1])), time)
+        cursor = yield pose_edit(doc, c2d.position_values(asset, xy), time, f"Move {asset}", autokey)
 
 
-def ik_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> Drag:
-    """Right-drag: pull the picked point of ``joint`` towards the cursor with the IK solver
-    (the document's IK settings; see ``character2d.ik_drag``)."""
-    pose = c2d.evaluate_pose(doc, asset, time, block=False)
-    local = pose.to_local(joint, np.asarray(press, dtype=np.float64))
+def ik_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float,
+            autokey: bool = True) -> Drag:
+    """Right-drag: pull the picked point of ``joint`` towards the cursor with the IK solver.
+    Whatever the IK settings, ``character2d.ik_drag`` makes the keys (auto-key on) and
+    ``character2d.ik_values`` the unkeyed pose (auto-key off): one solve, one keyer."""
+    pose_now = c2d.evaluate_pose(doc, asset, time, block=False)
+    local = pose_now.to_local(joint, np.asarray(press, dtype=np.float64))
     cursor = yield None
     while True:
         target = np.asarray(cursor, dtype=np.float64)
-        cursor = yield c2d.ik_drag(doc, asset, joint, local, target, time)
+        if autokey:
+            command = c2d.ik_drag(doc, asset, joint, local, target, time)
+        else:
+            command = pose.PosePreview(doc, c2d.ik_values(doc, asset, joint, local, target, time), time,
+                                       "IK drag")
+        cursor = yield command
 
 
 def ik_source(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> FloatArray:
@@ -219,3 +238,55 @@ def onion_frames(frame: float, settings: OnionSettings, first: int, last: int) -
             if first <= f <= last:
                 ghosts.append((float(f), side, settings.opacity * (1.0 - (i - 1) / max(count, 1))))
     return ghosts
+
+
+# ------------------------------------------------------------- set key, copy, paste
+class PoseClipboard:
+    """The copied pose, shared by the 2D editor and the 3D view (one per application, so a
+    pose copied in one project pastes in another)."""
+
+    def __init__(self) -> None:
+        self.clip: pose.PoseClip | None = None
+
+
+pose_clipboard = PoseClipboard()
+
+
+def set_key_command(doc: Document, selection: tuple[str, str], time: float,
+                    whole_character: bool = False) -> Command | None:
+    """S / I: key the selected joint (with the character selected: its root and
+    position); Shift+S (``whole_character``): every joint of the selected character.
+    None when no character is selected."""
+    asset, joint = selection
+    if not asset or not pose.is_character(doc, asset):
+        return None
+    try:
+        if whole_character:
+            return pose.key_character_command(doc, asset, time)
+        return pose.key_selection_command(doc, asset, joint, time)
+    except (KeyError, ValueError):
+        return None  # the selected joint is not there (any more)
+
+
+def copy_selection(doc: Document, selection: tuple[str, str], time: float) -> pose.PoseClip | None:
+    """Ctrl+C: the selected joint's pose, or the whole character's when the character (its
+    root in the 2D editor) is selected. None when no character is selected."""
+    asset, joint = selection
+    if not asset or not pose.is_character(doc, asset):
+        return None
+    try:
+        return pose.copy_pose(doc, asset, joint, time)
+    except (KeyError, ValueError):
+        return None
+
+
+def paste_command(doc: Document, clip: pose.PoseClip | None, selection: tuple[str, str], time: float,
+                  mirrored: bool = False) -> Command | None:
+    """Ctrl+V / Ctrl+Shift+V: key the copied pose on the selected character (the one it
+    was copied from when none is selected) at ``time``; None when it does not fit."""
+    if clip is None:
+        return None
+    asset = selection[0] or clip.source
+    if not asset or not pose.is_character(doc, asset):
+        return None
+    return pose.paste_pose_command(doc, clip, asset, time, mirrored)

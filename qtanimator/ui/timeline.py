@@ -1,5 +1,9 @@
 """The timeline: frame ruler, key ticks, the current-frame cursor, the simulation cache
-bar, and the play controls.
+bar, the play controls and the auto-key button.
+
+Auto-key (``autoKeyButton`` / ``actionAutoKey``, red while on, like Blender's record
+button): on, posing keys at once; off, a drag only poses and S keys (see
+:mod:`qtanimator.document.pose`). Per project, saved with it as view state.
 
 Keys follow the reference animator: Space play / pause, ←/→ step (wrapping), Shift+←/→
 ±10 frames, Alt+←/→ previous / next key, Home or ↑ start, End or ↓ end, ``[`` / ``]``
@@ -17,13 +21,16 @@ import numpy.typing as npt
 from PySide6.QtCore import QElapsedTimer, QPointF, QRectF, QSize, Qt, QTimer, Signal
 from PySide6.QtGui import (
     QAction,
+    QBrush,
     QColor,
     QFont,
+    QIcon,
     QKeySequence,
     QMouseEvent,
     QPainter,
     QPaintEvent,
     QPen,
+    QPixmap,
     QResizeEvent,
 )
 from PySide6.QtWidgets import (
@@ -37,6 +44,7 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator.core.channel import Channel
+from qtanimator.document import pose
 from qtanimator.document.commands import Macro, SetParameter
 from qtanimator.document.document import Document, DocumentChange, split_channel_id
 from qtanimator.ui.context import EditorContext
@@ -46,7 +54,7 @@ if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
 
 __all__ = ["CacheBar", "Playback", "TimelineWidget", "TimelinePanel", "install", "key_frames",
-           "playback_frame"]
+           "make_autokey_action", "playback_frame"]
 
 RANGE_STEP = 100
 MARGIN = 10
@@ -362,6 +370,16 @@ class TimelinePanel(QWidget):
             button.setObjectName(name.replace("action", "button"))
             button.setAutoRaise(True)
             row.addWidget(button)
+        autokey = actions.get("actionAutoKey")
+        self.autokey_button: QToolButton | None = None
+        if autokey is not None:
+            row.addSpacing(6)
+            self.autokey_button = QToolButton(self)
+            self.autokey_button.setDefaultAction(autokey)
+            self.autokey_button.setObjectName("autoKeyButton")
+            self.autokey_button.setToolButtonStyle(Qt.ToolButtonStyle.ToolButtonTextBesideIcon)
+            self.autokey_button.setStyleSheet(AUTOKEY_STYLE)
+            row.addWidget(self.autokey_button)
         row.addSpacing(12)
         row.addWidget(QLabel("Frame", self))
         self.frame_box = QSpinBox(self)
@@ -378,6 +396,8 @@ class TimelinePanel(QWidget):
         layout.addLayout(row)
         layout.addWidget(self.timeline, 1)
         self.frame_box.valueChanged.connect(lambda v: ctx.set_frame(float(v)))
+        # An unkeyed pose (auto-key off) lasts until the frame changes.
+        ctx.frameChanged.connect(lambda _f: pose.clear_pending(ctx.doc))
         ctx.frameChanged.connect(self._sync)
         ctx.documentChanged.connect(lambda _e: self._sync())
         ctx.documentReset.connect(self._sync)
@@ -518,6 +538,42 @@ def _make_actions(window: MainWindow, playback: Playback, control: TimelineContr
     return actions
 
 
+#: The auto-key button: red while on (Blender's record button).
+AUTOKEY_STYLE = ("QToolButton#autoKeyButton:checked { background-color: rgb(200, 30, 30); color: white; "
+                 "border: 1px solid rgb(120, 0, 0); border-radius: 3px; }")
+
+
+def _record_icon() -> QIcon:
+    icon = QIcon()
+    for state, color in ((QIcon.State.On, QColor(230, 30, 30)), (QIcon.State.Off, QColor(130, 130, 130))):
+        pixmap = QPixmap(16, 16)
+        pixmap.fill(Qt.GlobalColor.transparent)
+        p = QPainter(pixmap)
+        p.setRenderHint(QPainter.RenderHint.Antialiasing, True)
+        p.setPen(QPen(QColor(255, 255, 255) if state == QIcon.State.On else QColor(90, 90, 90), 1))
+        p.setBrush(QBrush(color))
+        p.drawEllipse(QRectF(2.5, 2.5, 11, 11))
+        p.end()
+        icon.addPixmap(pixmap, QIcon.Mode.Normal, state)
+    return icon
+
+
+def make_autokey_action(ctx: EditorContext, parent: QWidget) -> QAction:
+    """The checkable auto-key action (``actionAutoKey``), kept in step with the document:
+    the toggle is the project's (``document.pose.autokey``), a new or opened project
+    brings its own."""
+    action = QAction("Auto-Key", parent)
+    action.setObjectName("actionAutoKey")
+    action.setCheckable(True)
+    action.setIcon(_record_icon())
+    action.setToolTip("Auto-key: when on (red), posing keys at once; when off, posing only shows the pose "
+                      "until the frame changes, and S / I (Shift+S: the whole character) keys it")
+    action.setChecked(pose.autokey(ctx.doc))
+    action.toggled.connect(lambda on: pose.set_autokey(ctx.doc, on))
+    ctx.documentReset.connect(lambda: action.setChecked(pose.autokey(ctx.doc)))
+    return action
+
+
 #: Widgets (by object name) that get the timeline's keys when they have the focus. Trees,
 #: lists and sliders (the Joints dock, the curve editor's channel tree) keep their arrow keys.
 KEY_TARGETS = ("rigEditorView", "viewport3d", "curvePlot")
@@ -540,8 +596,11 @@ def install(window: MainWindow) -> None:
     playback = Playback(ctx, window)
     control = TimelineController(ctx, playback)
     actions = _make_actions(window, playback, control)
-    panel = TimelinePanel(ctx, playback, actions)
+    autokey = make_autokey_action(ctx, window)
+    panel = TimelinePanel(ctx, playback, {**actions, "actionAutoKey": autokey})
     panel.addActions(list(actions.values()))
+    window.autokey_action = autokey  # type: ignore[attr-defined]
+    window.edit_menu.addAction(autokey)
     window.playback = playback  # type: ignore[attr-defined]
     window.timeline_control = control  # type: ignore[attr-defined]
     window.timeline_actions = actions  # type: ignore[attr-defined]

@@ -707,8 +707,16 @@ class Viewport3D(QWidget):
         key = self._joint_key(asset_id, joint)
         self.ctx.select(asset_id, key)
         world = self._pose(asset_id).world_matrices()
+        from qtanimator.document.pose import autokey, clear_pending
+
+        if not getattr(self, "_drops_pending", False):
+            # An unkeyed pose (auto-key off) lasts until the frame changes, with or
+            # without a timeline or a 2D editor in the window.
+            ctx = self.ctx
+            ctx.frameChanged.connect(lambda _f: clear_pending(ctx.doc))
+            self._drops_pending = True
         return {"asset": asset_id, "joint": joint, "anchor": world[joint, :3, 3].copy(),
-                "gesture": self.ctx.begin_gesture(f"IK drag {key}")}
+                "autokey": autokey(self.ctx.doc), "gesture": self.ctx.begin_gesture(f"IK drag {key}")}
 
     def _pose(self, asset_id: str) -> Any:
         from qtanimator.document import character3d
@@ -716,27 +724,97 @@ class Viewport3D(QWidget):
         return character3d.pose_skeleton(self.ctx.doc, asset_id, self.ctx.time)
 
     def _drag_ik(self, pos: QPointF) -> None:
-        from qtanimator.core.ik3d import solve_ik
+        """One IK step towards the cursor: keyed at the current frame (auto-key on) or only
+        shown as the unkeyed pose (auto-key off; ``document.pose``)."""
         from qtanimator.document import character3d
+        from qtanimator.document.pose import PosePreview
 
         assert self._drag is not None
         target = self._on_view_plane(pos, self._drag["anchor"])
         if target is None:
             return
         asset_id, joint = self._drag["asset"], self._drag["joint"]
-        skel = self._pose(asset_id)
-        result = solve_ik(skel, joint, target, dofs=ik_dofs(skel, joint, self.ik_chain_length))
-        if not result.values:
+        doc, time = self.ctx.doc, self.ctx.time
+        skel = character3d.character(doc, asset_id).skeleton  # the chain: structure only
+        values = character3d.ik_values(doc, asset_id, joint, target, time,
+                                       ik_dofs(skel, joint, self.ik_chain_length))
+        if not values:
             return
-        values = {(j, axis): v for (j, axis), v in result.by_axis_name().items()}
         gesture = self._drag["gesture"]
-        if gesture.active:
-            gesture.update(character3d.set_dofs_command(self.ctx.doc, asset_id, values, self.ctx.time))
+        if not gesture.active:
+            return
+        if self._drag.get("autokey", True):
+            gesture.update(character3d.set_dofs_command(doc, asset_id, values, time))
+        else:
+            gesture.update(PosePreview(doc, character3d.dof_values(doc, asset_id, values), time, "IK drag"))
+
+    # ------------------------------------------------------ set key, copy, paste
+    def _say(self, text: str) -> None:
+        bar = getattr(self.window(), "statusBar", None)
+        if callable(bar):
+            bar().showMessage(text, 4000)
+
+    def _selects_character(self) -> bool:
+        from qtanimator.document.character3d import ASSET_KIND
+
+        asset = self.ctx.doc.assets.get(self.ctx.selection[0])
+        return asset is not None and asset.kind == ASSET_KIND
+
+    def set_key(self, whole_character: bool = False) -> bool:
+        """S / I: key the selected joint's DOFs; Shift+S every DOF of its character."""
+        from qtanimator.ui.rig_interaction import set_key_command
+
+        if self._drag is not None and self._drag.get("gesture") is not None:
+            return False
+        command = set_key_command(self.ctx.doc, self.ctx.selection, self.ctx.time, whole_character)
+        if command is None:
+            self._say("Select a joint to key.")
+            return False
+        self.ctx.push(command)
+        return True
+
+    def copy_pose(self) -> bool:
+        """Ctrl+C: copy the selected joint's rotation (the whole character's when the
+        character is selected)."""
+        from qtanimator.ui.rig_interaction import copy_selection, pose_clipboard
+
+        clip = copy_selection(self.ctx.doc, self.ctx.selection, self.ctx.time)
+        if clip is None:
+            self._say("Select a joint or a character to copy its pose.")
+            return False
+        pose_clipboard.clip = clip
+        self._say(f"Copied the pose of {len(clip.values)} joint{'s' if len(clip.values) != 1 else ''}.")
+        return True
+
+    def paste_pose(self, mirrored: bool = False) -> bool:
+        """Ctrl+V / Ctrl+Shift+V: key the copied pose (mirrored) at the current frame.
+        (Keys of :meth:`keyPressEvent`, which sees them from the GL surface too.)"""
+        from qtanimator.ui.rig_interaction import paste_command, pose_clipboard
+
+        if self._drag is not None and self._drag.get("gesture") is not None:
+            return False
+        command = paste_command(self.ctx.doc, pose_clipboard.clip, self.ctx.selection, self.ctx.time, mirrored)
+        if command is None:
+            self._say("Nothing to paste here: copy a pose of a character like this one first.")
+            return False
+        self.ctx.push(command)
+        return True
 
     # ----------------------------------------------------------------- keys
     def keyPressEvent(self, event: QKeyEvent) -> None:
         key = event.key()
-        if key == Qt.Key.Key_F:
+        mods = event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
+        ctrl, shift = Qt.KeyboardModifier.ControlModifier, Qt.KeyboardModifier.ShiftModifier
+        plain = mods in (Qt.KeyboardModifier.NoModifier, shift)
+        if key in (Qt.Key.Key_S, Qt.Key.Key_I) and plain and self._selects_character():
+            # Set key (S / I; Shift+S the whole character) when a 3D character is selected;
+            # otherwise S keeps moving the live cloth's pins.
+            self.set_key(whole_character=bool(mods & shift))
+        elif key == Qt.Key.Key_C and mods == ctrl:
+            self.copy_pose()
+        elif key == Qt.Key.Key_V and mods in (ctrl, ctrl | shift):
+            self.paste_pose(mirrored=bool(mods & shift))
+        elif key == Qt.Key.Key_F:
             self.frame_selection()
         elif key in PIN_KEYS or key in PIN_TURNS:
             if not self.live.enabled:
