@@ -105,6 +105,11 @@ class Joint:
     children: list[int] = field(default_factory=list)
     mass_properties: MassProperties | None = None
     reference_mass_properties: MassProperties | None = None
+    #: The joint's own drawing as a standalone SVG document (its elements with the
+    #: definitions they use, minus the pivot marker and the child joints) in the joint's
+    #: rest frame, the frame of ``shapes``; drawn by a real SVG renderer. None: draw
+    #: ``shapes`` (characters built from geometry alone).
+    svg: str | None = None
 
     @property
     def mass(self) -> float:
@@ -160,6 +165,9 @@ class Character:
         self.joints = joints
         self.source = source
         self.warnings = list(warnings or [])
+        #: Names of the drawing's layers and top-level groups that could become joints
+        #: (filled by the SVG reader for a drawing that is not rigged).
+        self.joint_candidates: list[str] = []
         for i, j in enumerate(joints):
             if i == 0 and j.parent is not None:
                 raise ValueError("the first joint must be the root")

@@ -2,8 +2,14 @@
 
 Characters draw joint by joint in pre-order (children cover parents), each joint's shapes in
 document order; a joint's world matrix becomes the painter's transform, so shapes keep
-their rest-pose geometry. Fills, strokes (width, colour, alpha) and element opacity follow
-SVG; open polylines with a fill are filled as SVG does.
+their rest-pose geometry.
+
+A joint read from SVG carries its own SVG document (``Joint.svg``) and is drawn by QtSvg as
+its author drew it (gradients, holes, caps, joins, dashes, group opacity, clip paths, masks,
+markers, filters: :mod:`qtanimator.render.svg_draw`); the selection, hover and onion-skin
+tints are then laid over the joint's silhouette, taken from its geometry. ``mode="geometry"``
+draws the flattened shapes instead (the path of characters built without SVG, and the
+drawing of earlier versions): fills, strokes (width, colour, alpha) and element opacity.
 """
 
 from __future__ import annotations
@@ -14,16 +20,28 @@ from collections.abc import Iterable, Sequence
 import numpy as np
 import numpy.typing as npt
 from PySide6.QtCore import QPointF, QRectF, Qt
-from PySide6.QtGui import QBrush, QColor, QImage, QPainter, QPainterPath, QPen, QPolygonF, QTransform
+from PySide6.QtGui import (
+    QBrush,
+    QColor,
+    QImage,
+    QPainter,
+    QPainterPath,
+    QPainterPathStroker,
+    QPen,
+    QPolygonF,
+    QTransform,
+)
 
 from qtanimator.core.rig2d import RGBA, Character, Pose, Shape
 from qtanimator.document.character2d import character, character_assets, evaluate_pose
 from qtanimator.document.document import Document
+from qtanimator.render.svg_draw import draw_joint
 
 _PATHS: weakref.WeakKeyDictionary[Character, list[list[QPainterPath]]] = weakref.WeakKeyDictionary()
 
 HIGHLIGHT_SELECTED = 0.5
 HIGHLIGHT_HOVER = 0.35
+_SILHOUETTES: weakref.WeakKeyDictionary[Character, dict[int, QPainterPath]] = weakref.WeakKeyDictionary()
 
 
 def shape_path(shape: Shape) -> QPainterPath:
@@ -46,6 +64,24 @@ def character_paths(ch: Character) -> list[list[QPainterPath]]:
         paths = [[shape_path(s) for s in j.shapes] for j in ch.joints]
         _PATHS[ch] = paths
     return paths
+
+
+def joint_silhouette(ch: Character, joint: int) -> QPainterPath:
+    """The area a joint's geometry covers (fills and stroke bands united), built once."""
+    cache = _SILHOUETTES.setdefault(ch, {})
+    path = cache.get(joint)
+    if path is None:
+        path = QPainterPath()
+        path.setFillRule(Qt.FillRule.WindingFill)
+        for shape, outline in zip(ch.joints[joint].shapes, character_paths(ch)[joint]):
+            if shape.fill[3] > 0 and len(shape.points) >= 3:
+                path = path.united(outline)
+            if shape.stroke[3] > 0 and shape.stroke_width > 0:
+                stroker = QPainterPathStroker()
+                stroker.setWidth(float(shape.stroke_width))
+                path = path.united(stroker.createStroke(outline))
+        cache[joint] = path
+    return path
 
 
 def joint_transform(pose: Pose, joint: int) -> QTransform:
@@ -75,22 +111,32 @@ def _clamp(v: float) -> float:
 
 
 def draw_character(painter: QPainter, ch: Character, pose: Pose, *, highlight: int | None = None,
-                   tint: QColor | None = None, opacity: float = 1.0, hover: int | None = None) -> None:
+                   tint: QColor | None = None, opacity: float = 1.0, hover: int | None = None,
+                   mode: str = "svg") -> None:
     """Draw a posed character with the painter's current transform as the view.
 
-    ``highlight`` lifts the selected joint's fill by 0.5 (wrapped at 1, as the reference
-    program); ``hover`` by 0.35 (clamped); ``tint`` mixes every colour towards a colour by
-    its alpha (onion skins); ``opacity`` multiplies everything.
+    ``highlight`` lifts the selected joint's colours by 0.5 (geometry: wrapped at 1, as the
+    reference program; SVG: the difference with mid grey, the same for colours above 0.5);
+    ``hover`` by 0.35 (clamped); ``tint`` mixes every colour towards a colour by its alpha
+    (onion skins); ``opacity`` multiplies everything. ``mode`` is ``"svg"`` (joints that
+    carry an SVG document are drawn by QtSvg) or ``"geometry"`` (the flattened shapes).
     """
+    if mode not in ("svg", "geometry"):
+        raise ValueError(f"unknown drawing mode '{mode}' (svg or geometry)")
     paths = character_paths(ch)
     base_opacity = painter.opacity()
     painter.save()
     painter.setRenderHint(QPainter.RenderHint.Antialiasing, True)
     base = painter.worldTransform()
     for i, joint in enumerate(ch.joints):
-        if not joint.shapes:
+        if not joint.shapes and not (mode == "svg" and joint.svg):
             continue
         painter.setWorldTransform(joint_transform(pose, i) * base)
+        if mode == "svg" and joint.svg:
+            painter.setOpacity(base_opacity * opacity)
+            if draw_joint(painter, joint.svg):
+                _overlay(painter, ch, i, highlight, hover, tint)
+                continue
         lift, wrap = 0.0, True
         if highlight == i:
             lift = HIGHLIGHT_SELECTED
@@ -112,6 +158,27 @@ def draw_character(painter: QPainter, ch: Character, pose: Pose, *, highlight: i
             else:
                 painter.setPen(Qt.PenStyle.NoPen)
             painter.drawPath(path)
+    painter.restore()
+
+
+def _overlay(painter: QPainter, ch: Character, i: int, highlight: int | None, hover: int | None,
+             tint: QColor | None) -> None:
+    """Selection, hover and tint laid over a joint drawn by QtSvg, on its silhouette."""
+    if highlight != i and hover != i and tint is None:
+        return
+    silhouette = joint_silhouette(ch, i)
+    if silhouette.isEmpty():
+        return
+    painter.save()
+    if highlight == i:
+        painter.setCompositionMode(QPainter.CompositionMode.CompositionMode_Difference)
+        painter.fillPath(silhouette, QColor.fromRgbF(HIGHLIGHT_SELECTED, HIGHLIGHT_SELECTED, HIGHLIGHT_SELECTED))
+    elif hover == i:
+        painter.setCompositionMode(QPainter.CompositionMode.CompositionMode_Plus)
+        painter.fillPath(silhouette, QColor.fromRgbF(HIGHLIGHT_HOVER, HIGHLIGHT_HOVER, HIGHLIGHT_HOVER))
+    if tint is not None:
+        painter.setCompositionMode(QPainter.CompositionMode.CompositionMode_SourceOver)
+        painter.fillPath(silhouette, tint)
     painter.restore()
 
 

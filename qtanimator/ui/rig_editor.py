@@ -118,7 +118,19 @@ class JointSprites:
         from qtanimator.core.rig2d import Character
 
         joint = character.joints[index]
-        boxes = [s.bounds() for s in joint.shapes]
+        boxes = [tuple(s.bounds()) for s in joint.shapes]
+        if joint.svg:
+            # What the SVG draws can reach past the geometry (blur, shadows, markers, wide
+            # strokes) or exist without it (text, images): the recorded picture's box too.
+            from qtanimator.render.svg_draw import joint_drawing
+
+            drawing = joint_drawing(joint.svg)
+            if drawing is not None:
+                r = drawing[1].boundingRect()   # whole units: one unit of margin covers it
+                if r.isValid():
+                    boxes.append((r.left() - 1.0, r.top() - 1.0, r.right() + 2.0, r.bottom() + 2.0))
+        if not boxes:
+            return None
         x0 = min(b[0] for b in boxes) - self.PAD / scale
         y0 = min(b[1] for b in boxes) - self.PAD / scale
         x1 = max(b[2] for b in boxes) + self.PAD / scale
@@ -150,7 +162,7 @@ class JointSprites:
         painter.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, True)
         cid = id(character)
         for i, joint in enumerate(character.joints):
-            if not joint.shapes:
+            if not joint.shapes and not joint.svg:
                 continue
             state = "selected" if i == highlight else ("hover" if i == hover else "")
             key = (cid, i, state)

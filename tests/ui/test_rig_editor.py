@@ -387,3 +387,38 @@ def test_timeline_keys_work_in_the_editor_and_f_fits(qtbot, arm):
     view.scale(3.0, 3.0)
     qtbot.keyClick(view, Qt.Key.Key_F)
     assert view.transform().m11() == pytest.approx(fitted)
+
+
+def test_playback_sprites_keep_what_the_svg_draws_beyond_the_geometry(make_window, qtbot, tmp_path):
+    """While playing, the editor draws each joint from an image made once: a drop shadow
+    reaching past the shapes must be in it (the picture is sized from what the SVG draws,
+    not from the geometry alone), so the playing picture equals the still one."""
+    from PySide6.QtGui import QImage
+
+    svg = ('<svg xmlns="http://www.w3.org/2000/svg" width="200" height="200"><g id="body">'
+           '<defs><filter id="d" x="-50%" y="-50%" width="200%" height="200%">'
+           '<feGaussianBlur in="SourceAlpha" stdDeviation="3"/><feOffset dx="30" dy="30" result="o"/>'
+           '<feMerge><feMergeNode in="o"/><feMergeNode in="SourceGraphic"/></feMerge></filter></defs>'
+           '<rect x="40" y="40" width="60" height="60" fill="tomato" filter="url(#d)"/>'
+           '<circle cx="70" cy="70" r="2" fill="black"/></g></svg>')
+    path = tmp_path / "shadow.svg"
+    path.write_text(svg)
+    window = make_window()
+    assert window.open_path(path)
+    view = window.findChild(QGraphicsView, "rigEditorView")
+    view.fit_view()
+    qtbot.wait(20)
+
+    def grab(mode: str) -> np.ndarray:
+        view.sprite_mode = mode
+        view.sprites.clear()
+        view.viewport().update()
+        qtbot.wait(30)
+        img = view.viewport().grab().toImage().convertToFormat(QImage.Format.Format_RGBA8888)
+        return np.frombuffer(img.constBits(), np.uint8).reshape(img.height(), img.width(), 4).astype(int)
+
+    still, playing = grab("never"), grab("always")
+    shadow = (np.abs(still[..., :3] - still[0, 0, :3]).sum(axis=2) > 0)
+    assert shadow.sum() > 500      # something beyond the rectangle is drawn
+    differ = np.abs(still[..., :3] - playing[..., :3]).max(axis=2) > 48
+    assert differ.mean() < 0.01
