@@ -13,6 +13,7 @@ so a pose only needs one 3×3 matrix per joint.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -168,6 +169,11 @@ class Character:
         #: Names of the drawing's layers and top-level groups that could become joints
         #: (filled by the SVG reader for a drawing that is not rigged).
         self.joint_candidates: list[str] = []
+        #: Each candidate's element reference in the SVG (see ``formats.svg_rig``'s rig spec).
+        self.candidate_elements: dict[str, str] = {}
+        #: The rig spec that rebuilds this character from its SVG (plain data; the asset
+        #: property ``rig`` once it is rigged in the program), or None.
+        self.rig_spec: dict[str, Any] | None = None
         for i, j in enumerate(joints):
             if i == 0 and j.parent is not None:
                 raise ValueError("the first joint must be the root")

@@ -74,12 +74,15 @@ FloatArray = npt.NDArray[np.float64]
 def load_character_asset(asset: Asset) -> Character:
     """Loader for ``character2d`` assets (registered in :mod:`qtanimator.document.loaders`)."""
     from qtanimator.formats.errors import FormatError
-    from qtanimator.formats.svg_rig import load_characters
+    from qtanimator.formats.svg_rig import load_characters, load_rigged_character
 
     if asset.source is None:
         raise FormatError(f"the 2D character '{asset.id}' has no source file.")
-    chars = load_characters(asset.source)
     index = int(asset.properties.get("index", 0))
+    rig = asset.properties.get("rig")
+    if rig is not None:  # rigged in the program (qtanimator.document.rigging): the SVG is unchanged
+        return load_rigged_character(asset.source, index, rig)
+    chars = load_characters(asset.source)
     if not 0 <= index < len(chars):
         raise FormatError(f"the 2D character '{asset.id}' refers to character {index + 1}, but the "
                           f"source holds {len(chars)}.", asset.source)

@@ -137,9 +137,32 @@ class EditorContext(QObject):
         self._frame_clock.stop()
         pending, self._pending = self._pending, None
         if pending:
+            if pending.assets:
+                self._drop_stale_selection()
             self._since_flush.restart()
             self.notifications += 1
             self.documentChanged.emit(pending)
+
+    def _drop_stale_selection(self) -> None:
+        """A change removed the selected asset or joint (an undone "Make Joint", a removed
+        character): select what is left before any view hears of the change."""
+        asset, joint = self._selection
+        if not asset:
+            return
+        if asset not in self.doc.assets:
+            self.select("", "")
+            return
+        if joint:
+            runtime = self.doc.runtime.get(asset)
+            keys = getattr(runtime, "joint_keys", None)
+            if callable(keys):
+                names = set(keys())
+            elif isinstance(getattr(runtime, "joints", None), list):
+                names = {getattr(j, "name", None) for j in runtime.joints}
+            else:
+                return  # not loaded (or unknown): nothing to check against
+            if joint not in names:
+                self.select(asset, "")
 
     def push(self, command: Command) -> None:
         """Do a command and put it on the undo stack (merging drags into one step)."""

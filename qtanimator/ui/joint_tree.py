@@ -5,6 +5,10 @@ once the joint has keys), dynamic (pendulum) joints a white bob. Below the tree,
 panel shows one slider and spin box per degree of freedom of the selected joint within
 its limits; an edit keys the DOF at the current frame, and one slider drag is one gesture
 (``ctx.begin_gesture``): one undo step, and Escape during the drag puts the value back.
+
+Drag a 2D joint onto another joint of the same character to re-parent it (one undo step,
+:func:`qtanimator.document.rigging.reparent_command`); a drop that would make a joint hang
+from itself is refused with a message in the status bar.
 """
 
 from __future__ import annotations
@@ -17,9 +21,22 @@ from types import ModuleType
 from typing import TYPE_CHECKING
 
 import numpy as np
-from PySide6.QtCore import QPointF, Qt
-from PySide6.QtGui import QAction, QBrush, QColor, QIcon, QKeyEvent, QKeySequence, QPainter, QPen, QPixmap, QPolygonF
+from PySide6.QtCore import QPoint, QPointF, Qt
+from PySide6.QtGui import (
+    QAction,
+    QBrush,
+    QColor,
+    QIcon,
+    QKeyEvent,
+    QKeySequence,
+    QMouseEvent,
+    QPainter,
+    QPen,
+    QPixmap,
+    QPolygonF,
+)
 from PySide6.QtWidgets import (
+    QApplication,
     QDoubleSpinBox,
     QGridLayout,
     QHBoxLayout,
@@ -388,6 +405,74 @@ class JointTree(QTreeWidget):
         self._items: dict[tuple[str, str], QTreeWidgetItem] = {}
         self._syncing = False
         self.currentItemChanged.connect(self._current_changed)
+        #: A re-parenting drag: the joint item pressed, where, and whether it is moving.
+        self._press: tuple[QTreeWidgetItem, QPoint] | None = None
+        self.reparenting = False
+        self.last_message = ""
+
+    # ------------------------------------------------------- drag to re-parent
+    def mousePressEvent(self, event: QMouseEvent) -> None:
+        super().mousePressEvent(event)
+        item = self.itemAt(event.position().toPoint())
+        self._press = None
+        self.reparenting = False
+        if event.button() == Qt.MouseButton.LeftButton and item is not None and item.data(0, ROLE)[1]:
+            self._press = (item, event.position().toPoint())
+
+    def mouseMoveEvent(self, event: QMouseEvent) -> None:
+        if self._press is not None and event.buttons() & Qt.MouseButton.LeftButton:
+            moved = (event.position().toPoint() - self._press[1]).manhattanLength()
+            if moved >= QApplication.startDragDistance():
+                if not self.reparenting:
+                    self.reparenting = True
+                    self.viewport().setCursor(Qt.CursorShape.DragMoveCursor)
+                event.accept()
+                return
+        if not self.reparenting:
+            super().mouseMoveEvent(event)
+
+    def mouseReleaseEvent(self, event: QMouseEvent) -> None:
+        press, dragging = self._press, self.reparenting
+        self._press = None
+        self.reparenting = False
+        if dragging:
+            self.viewport().unsetCursor()
+        if press is None or not dragging or event.button() != Qt.MouseButton.LeftButton:
+            super().mouseReleaseEvent(event)
+            return
+        event.accept()
+        target = self.itemAt(event.position().toPoint())
+        if target is None or target is press[0]:
+            return
+        self.reparent(press[0].data(0, ROLE), target.data(0, ROLE))
+
+    def reparent(self, source: tuple[str, str], target: tuple[str, str]) -> bool:
+        """Make ``target`` (asset, joint) the parent of ``source``: one undo step."""
+        m2 = c2d()
+        asset, joint = source
+        doc = self.ctx.doc
+        if m2 is None or _asset_kind(doc, asset) != m2.ASSET_KIND:
+            return self._say("Only the joints of 2D characters can be re-parented here.")
+        if target[0] != asset:
+            return self._say("A joint can only hang from a joint of its own character.")
+        from qtanimator.document import rigging
+        from qtanimator.formats.errors import FormatError
+
+        parent = target[1] or doc.runtime[asset].joints[0].name
+        try:
+            command = rigging.reparent_command(doc, asset, joint, parent)
+        except (rigging.RigError, FormatError) as exc:
+            return self._say(str(exc))
+        self.ctx.push(command)
+        self.ctx.select(asset, joint)
+        return True
+
+    def _say(self, text: str) -> bool:
+        self.last_message = text
+        bar = getattr(self.window(), "statusBar", None)
+        if callable(bar):
+            bar().showMessage(text, 5000)
+        return False
 
     def rebuild(self) -> None:
         self._syncing = True
@@ -500,6 +585,10 @@ class JointTreePanel(QWidget):
         self.dofs.rebuild()
 
     def _document_changed(self, change: DocumentChange) -> None:
+        asset, joint = self.ctx.selection
+        if change.assets and joint and joint not in [n for n, _p, _d in joint_names(self.ctx.doc, asset)]:
+            # a rig edit (or its undo) removed the selected joint
+            self.ctx.select(asset if asset in self.ctx.doc.assets else "", "")
         if change.assets:
             self.tree.rebuild()
             self.dofs.rebuild()

@@ -23,6 +23,13 @@ overlays (the character's path with velocity (blue) and acceleration (red) arrow
 keys, the IK source (red) / target (blue) dots and gradient arrows, and the HUD).
 Onion skin: ghosts of earlier / later frames, with counts, step and tints.
 
+Rig mode (the toolbar's *Rig Mode*, ``actionRigMode``; Spine's setup mode) shows each
+character in its setup (rest) pose with its pivots and bones: left-drag a pivot marker to
+move the pivot (one undo step; Escape takes it back), click a joint to select it, right-click
+for *Make Joint From* (the drawing's layers and groups that are not joints yet; the new
+joint hangs from the joint clicked), *Mark Dynamic* and *Remove Joint*. Every rig edit is a
+command of :mod:`qtanimator.document.rigging`, saved in the project, never in the SVG.
+
 The gesture logic lives in :mod:`qtanimator.ui.rig_interaction` (no Qt).
 """
 
@@ -57,6 +64,7 @@ from PySide6.QtWidgets import (
     QGraphicsScene,
     QGraphicsView,
     QLabel,
+    QMenu,
     QSpinBox,
     QStyleOptionGraphicsItem,
     QToolBar,
@@ -232,6 +240,9 @@ class RigEditorView(QGraphicsView):
         self.debug = False
         self.onion = ri.OnionSettings()
         self.ik_toggle_mode = False
+        #: Rig mode (setup pose, pivots, rig edits) instead of animating.
+        self.rig_mode = False
+        self.rig_menu: QMenu | None = None
         self.frames_drawn = 0
         self.playing = False
         #: "playing" (sprites while playing), "always" or "never".
@@ -285,7 +296,10 @@ class RigEditorView(QGraphicsView):
             c2d = _c2d()
             doc, t = self.ctx.doc, self.ctx.time
             self._poses_exact = c2d.simulation_ready(doc, t)  # checked first: the worker only adds
-            self._poses = {aid: c2d.evaluate_pose(doc, aid, t, block=False) for aid in self.character_ids()}
+            if self.rig_mode:
+                self._poses = ri.rig_poses(doc, t)
+            else:
+                self._poses = {aid: c2d.evaluate_pose(doc, aid, t, block=False) for aid in self.character_ids()}
         return self._poses
 
     def selected_joint_index(self, asset: str) -> int | None:
@@ -318,6 +332,9 @@ class RigEditorView(QGraphicsView):
             self._sync_items()
             if self.ctx.selection[0] and self.ctx.selection[0] not in self.ctx.doc.assets:
                 self.ctx.select("", "")
+            elif self.ctx.selection[1] and self.selected_joint_index(self.ctx.selection[0]) is None:
+                # A rig edit (or its undo) removed the selected joint: select its character.
+                self.ctx.select(self.ctx.selection[0], "")
             if self.hover is not None and self.hover[0] not in self.ctx.doc.assets:
                 self.hover = None
             if not self._fitted:
@@ -417,6 +434,9 @@ class RigEditorView(QGraphicsView):
             return
         point = self.to_scene(event.position())
         time = self.ctx.time
+        if self.rig_mode:
+            self._rig_press(event, point)
+            return
         try:
             hit = ri.pick(self.ctx.doc, time, point)
         except ModuleNotFoundError:
@@ -464,6 +484,129 @@ class RigEditorView(QGraphicsView):
             event.accept()
             return
         super().mousePressEvent(event)
+
+    # -------------------------------------------------------------- rig mode
+    def set_rig_mode(self, on: bool) -> None:
+        """Enter or leave rig mode (the setup pose with pivots; see the module docstring)."""
+        if self._drag is not None:
+            self.abort_drag()
+        self.rig_mode = bool(on)
+        action = getattr(self, "rig_mode_action", None)
+        if action is not None and action.isChecked() != self.rig_mode:
+            action.setChecked(self.rig_mode)
+        self.hover = None
+        self.sprites.clear()
+        self._invalidate()
+
+    def _pixel_size(self) -> float:
+        return 1.0 / max(abs(self.viewportTransform().m11()), 1e-12)
+
+    def _rig_press(self, event: QMouseEvent, point: np.ndarray) -> None:
+        doc, time = self.ctx.doc, self.ctx.time
+        button = event.button()
+        if button == Qt.MouseButton.LeftButton:
+            grab = ri.pivot_at(doc, time, point, ri.PIVOT_GRAB_PX * self._pixel_size())
+            if grab is not None:
+                asset, joint = grab
+                character = doc.runtime[asset]
+                self.ctx.select(asset, character.joints[joint].name if joint else "")
+                self._gesture = self._new_gesture(f"Move Pivot of {character.joints[joint].name}")
+                self._drag = ri.pivot_drag(doc, asset, joint, point)
+                next(self._drag)
+                self._drag_button = button
+            else:
+                hit = ri.pick_rest(doc, time, point)
+                if hit is None:
+                    self.ctx.select("", "")
+                else:
+                    character = doc.runtime[hit[0]]
+                    self.ctx.select(hit[0], character.joints[hit[1]].name if hit[1] else "")
+            event.accept()
+            return
+        if button == Qt.MouseButton.RightButton:
+            hit = ri.pick_rest(doc, time, point)
+            if hit is None and self.character_ids():
+                hit = (self.ctx.selection[0] or self.character_ids()[-1], 0)
+            if hit is not None:
+                self.show_rig_menu(hit[0], hit[1], event.position().toPoint())
+            event.accept()
+            return
+        event.accept()
+
+    def show_rig_menu(self, asset: str, joint: int, pos: Any) -> QMenu:
+        """The rig-mode context menu of one joint, opened at viewport ``pos``."""
+        from qtanimator.document import rigging
+
+        doc = self.ctx.doc
+        character = doc.runtime[asset]
+        name = character.joints[joint].name
+        self.ctx.select(asset, name if joint else "")
+        menu = QMenu(self)
+        menu.setObjectName("rigMenu")
+        make = menu.addMenu("Make Joint From")
+        make.setObjectName("rigMakeJointMenu")
+        offered = rigging.candidates(doc, asset)
+        for label in offered:
+            action = make.addAction(label)
+            action.triggered.connect(lambda _c=False, lb=label: self._rig_edit(
+                lambda: rigging.make_joint_from_candidate(doc, asset, lb, parent=name), select=(asset, lb)))
+        make.setEnabled(bool(offered))
+        dynamic = menu.addAction("Mark Dynamic")
+        dynamic.setObjectName("actionMarkDynamic")
+        dynamic.setCheckable(True)
+        dynamic.setChecked(bool(character.joints[joint].is_dynamic))
+        dynamic.setEnabled(joint != 0)
+        dynamic.triggered.connect(lambda on: self._rig_edit(
+            lambda: rigging.set_dynamic_command(doc, asset, name, bool(on))))
+        remove = menu.addAction("Remove Joint")
+        remove.setObjectName("actionRemoveJoint")
+        remove.setEnabled(joint != 0)
+        remove.triggered.connect(lambda _c=False: self._rig_edit(
+            lambda: rigging.remove_joint_command(doc, asset, name), select=(asset, "")))
+        self.rig_menu = menu
+        menu.popup(self.viewport().mapToGlobal(pos))
+        return menu
+
+    def _rig_edit(self, build: Any, select: tuple[str, str] | None = None) -> bool:
+        from qtanimator.document.rigging import RigError
+        from qtanimator.formats.errors import FormatError
+
+        try:
+            command = build()
+        except (RigError, FormatError) as exc:
+            self._say(str(exc))
+            return False
+        self.ctx.push(command)
+        if select is not None:
+            character = self.ctx.doc.runtime.get(select[0])
+            if character is not None and select[1] and select[1] not in [j.name for j in character.joints]:
+                select = (select[0], character.joints[-1].name)
+            self.ctx.select(*select)
+        return True
+
+    def _draw_rig(self, painter: QPainter) -> None:
+        """Rig mode: bones from each pivot to its children's, and the pivot markers
+        (white: dynamic; the selected joint's ringed)."""
+        poses = self.poses()
+        radius = 5.0 * self._pixel_size()
+        for aid in self.character_ids():
+            character = self.ctx.doc.runtime[aid]
+            pose = poses.get(aid)
+            if pose is None:
+                continue
+            selected = self.selected_joint_index(aid)
+            painter.setPen(self._cosmetic(QColor(40, 40, 40, 200), 1.5))
+            for k, j in enumerate(character.joints):
+                if j.parent is not None:
+                    a, b = pose.pivots[j.parent], pose.pivots[k]
+                    painter.drawLine(QPointF(a[0], a[1]), QPointF(b[0], b[1]))
+            for k, j in enumerate(character.joints):
+                c = pose.pivots[k]
+                ring = QColor(255, 200, 0) if k == selected else QColor(20, 20, 20)
+                painter.setPen(self._cosmetic(ring, 3.0 if k == selected else 1.5))
+                painter.setBrush(QBrush(QColor(255, 255, 255) if j.is_dynamic else QColor(220, 40, 40)))
+                painter.drawEllipse(QPointF(c[0], c[1]), radius, radius)
+            painter.setBrush(Qt.BrushStyle.NoBrush)
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
         if self._pan_from is not None:
@@ -534,7 +677,7 @@ class RigEditorView(QGraphicsView):
 
     def _update_hover(self, point: np.ndarray) -> None:
         try:
-            hit = ri.pick(self.ctx.doc, self.ctx.time, point)
+            hit = (ri.pick_rest if self.rig_mode else ri.pick)(self.ctx.doc, self.ctx.time, point)
         except ModuleNotFoundError:
             hit = None
         if hit != self.hover:
@@ -648,6 +791,8 @@ class RigEditorView(QGraphicsView):
         self.frames_drawn += 1
         if pose_doc.has_pending(self.ctx.doc, self.ctx.time):
             self._draw_unkeyed_note(painter)
+        if self.rig_mode:
+            self._draw_rig(painter)
         if not self.debug:
             return
         ids = self.character_ids()
@@ -805,8 +950,16 @@ class RigEditor(QWidget):
         self.debug_action.setToolTip("Paths, velocity / acceleration arrows, IK arrows and the HUD (d)")
         self.debug_action.toggled.connect(view.set_debug)
         view.debug_action = self.debug_action  # type: ignore[attr-defined]
+        self.rig_mode_action = QAction("Rig Mode", self)
+        self.rig_mode_action.setObjectName("actionRigMode")
+        self.rig_mode_action.setCheckable(True)
+        self.rig_mode_action.setToolTip("Setup pose: drag pivots; right-click a joint to make joints from "
+                                        "layers, mark it dynamic or remove it")
+        self.rig_mode_action.toggled.connect(view.set_rig_mode)
+        view.rig_mode_action = self.rig_mode_action  # type: ignore[attr-defined]
         self.toolbar.addAction(self.fit_action)
         self.toolbar.addAction(self.debug_action)
+        self.toolbar.addAction(self.rig_mode_action)
         self.addAction(self.fit_action)
         self.pose_actions = self._pose_actions()
 

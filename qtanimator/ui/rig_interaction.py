@@ -290,3 +290,55 @@ def paste_command(doc: Document, clip: pose.PoseClip | None, selection: tuple[st
     if not asset or not pose.is_character(doc, asset):
         return None
     return pose.paste_pose_command(doc, clip, asset, time, mirrored)
+
+
+# -------------------------------------------------------------- rig mode (setup)
+#: How near (in pixels) a press must be to a pivot marker to grab it in rig mode.
+PIVOT_GRAB_PX = 8.0
+
+
+def rig_poses(doc: Document, time: float) -> dict[str, Any]:
+    """Rig mode shows the setup (rest) pose of each character, at its position at ``time``."""
+    out = {}
+    for aid in character_ids(doc):
+        ch = doc.runtime[aid]
+        out[aid] = ch.pose(np.zeros(len(ch.joints)), c2d.translation(doc, aid, time))
+    return out
+
+
+def pick_rest(doc: Document, time: float, point: Sequence[float],
+              tolerance: float = PICK_TOLERANCE) -> tuple[str, int] | None:
+    """The topmost (character, joint) under ``point`` in the setup pose (rig mode)."""
+    poses = rig_poses(doc, time)
+    for aid in reversed(character_ids(doc)):
+        j = doc.runtime[aid].hit_test(poses[aid], np.asarray(point, dtype=np.float64), tolerance)
+        if j is not None:
+            return aid, int(j)
+    return None
+
+
+def pivot_at(doc: Document, time: float, point: Sequence[float], radius: float) -> tuple[str, int] | None:
+    """The pivot marker nearest ``point`` within ``radius`` (scene units), in rig mode;
+    the last drawn wins a tie."""
+    best: tuple[float, tuple[str, int]] | None = None
+    q = np.asarray(point, dtype=np.float64)
+    for aid, pose_ in rig_poses(doc, time).items():
+        d = np.hypot(*(pose_.pivots - q).T)
+        for j in np.flatnonzero(d <= radius):
+            if best is None or d[j] <= best[0]:
+                best = (float(d[j]), (aid, int(j)))
+    return None if best is None else best[1]
+
+
+def pivot_drag(doc: Document, asset: str, joint: int, press: Sequence[float]) -> Drag:
+    """Left-drag on a pivot marker in rig mode: move the joint's rest pivot with the cursor."""
+    from qtanimator.document import rigging
+
+    ch = doc.runtime[asset]
+    name = ch.joints[joint].name
+    start = np.asarray(ch.rest_pivots[joint], dtype=np.float64).copy()
+    p0 = np.asarray(press, dtype=np.float64)
+    cursor = yield None
+    while True:
+        xy = start + (np.asarray(cursor, dtype=np.float64) - p0)
+        cursor = yield rigging.set_pivot_command(doc, asset, name, (float(xy[0]), float(xy[1])))

@@ -139,3 +139,24 @@ def test_a_dof_slider_drag_is_one_gesture_and_escape_puts_it_back(demo, qtbot):
     assert math.degrees(float(c2d.joint_angles(doc, "pip", window.ctx.time)[head])) == pytest.approx(shown)
     window.ctx.undo_stack.undo()
     assert doc.state() == before
+
+
+def test_a_change_that_removes_the_selected_asset_or_joint_clears_that_selection(qtbot, tmp_path):
+    """Views hear of a change only after the selection stopped naming what the change
+    removed (an undone "Make Joint", a removed character)."""
+    from qtanimator.document.commands import RemoveAsset
+    from qtanimator.document.io import open_document
+    from qtanimator.paths import scenes_dir
+    from qtanimator.ui.context import EditorContext
+
+    ctx = EditorContext(open_document(scenes_dir() / "demo" / "demo.qtanim"))
+    seen: list[tuple[str, str]] = []
+    ctx.documentChanged.connect(lambda _c: seen.append(ctx.selection))
+    ctx.select("pip", "no_such_joint")
+    ctx.push(RemoveAsset(ctx.doc, "pendulum_clock"))        # another asset changed: the stale joint goes
+    assert ctx.selection == ("pip", "") and seen[-1] == ("pip", "")
+    ctx.select("pip", "hand_right")
+    ctx.push(RemoveAsset(ctx.doc, "robot"))
+    assert ctx.selection == ("pip", "hand_right")   # still there: kept
+    ctx.push(RemoveAsset(ctx.doc, "pip"))
+    assert ctx.selection == ("", "") and seen[-1] == ("", "")
