@@ -361,7 +361,8 @@ class _Builder:
             raise _NotARig(f"joint {index} ('{name}') has no centre circle and its last element "
                            "has no geometry to take a centre from.", self.path)
         allp = np.concatenate(pts)
-        c = (allp.min(axis=0) + allp.max(axis=0)) / 2.0
+        # Halves first: the midpoint of coordinates near the float limit does not overflow.
+        c = allp.min(axis=0) / 2.0 + allp.max(axis=0) / 2.0
         self.warnings.append(f"joint {index} ('{name}'): the last element is a <{_tag(el)}>, not a "
                              f"<circle>; using its bounding-box centre ({c[0]:.3f}, {c[1]:.3f}) as the pivot.")
         return c, white

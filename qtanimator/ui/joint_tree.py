@@ -52,6 +52,7 @@ from PySide6.QtWidgets import (
 from qtanimator.document.commands import Command, Macro
 from qtanimator.document.document import Document, DocumentChange, split_channel_id
 from qtanimator.document.gesture import Gesture
+from qtanimator.document.pose import PosePreview, autokey
 from qtanimator.ui.context import EditorContext
 
 if TYPE_CHECKING:
@@ -95,6 +96,10 @@ class DofSpec:
     maximum: float
     make: Callable[[float, float, object], Command]
     suffix: str = "°"
+    #: The channel this DOF keys and how a display value becomes its value: with auto-key
+    #: off the slider only poses (the pending, unkeyed pose) through them.
+    channel: str = ""
+    to_doc: Callable[[float], float] = float
 
 
 def _asset_kind(doc: Document, asset: str) -> str:
@@ -120,15 +125,17 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
                     return m2.move_character(doc, asset, xy, t, gesture=gesture)
                 return make
 
-            return [DofSpec("x", tx, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(0), ""),
-                    DofSpec("y", ty, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(1), "")]
+            cx, cy = m2.position_channel_ids(asset)
+            return [DofSpec("x", tx, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(0), "", cx),
+                    DofSpec("y", ty, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(1), "", cy)]
         index = runtime.joint_index(joint)
         angle = float(np.asarray(m2.joint_angles(doc, asset, time, block=False))[index])
 
         def key(value: float, t: float, gesture: object) -> Command:
             return m2.key_joint(doc, asset, index, math.radians(value), t, gesture=gesture)
 
-        return [DofSpec("angle", math.degrees(angle), -360.0, 360.0, key)]
+        return [DofSpec("angle", math.degrees(angle), -360.0, 360.0, key, "°",
+                        m2.angle_channel_id(asset, joint), math.radians)]
     if m3 is not None and kind == m3.ASSET_KIND and runtime is not None and not joint:
         posed = m3.pose_skeleton(doc, asset, time)
         root = np.asarray(getattr(posed, "root_translation", np.zeros(3)), dtype=np.float64)
@@ -138,7 +145,7 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
                 return m3.set_dof_command(doc, asset, None, "t" + a, value, t, gesture=gesture)
 
             specs3.append(DofSpec(f"translate {axis}", float(root[axis_i]), -TRANSLATION_LIMIT,
-                                  TRANSLATION_LIMIT, move3, ""))
+                                  TRANSLATION_LIMIT, move3, "", m3.dof_channel_id(doc, asset, None, axis)))
         return specs3
     if m3 is not None and kind == m3.ASSET_KIND and runtime is not None and joint:
         skeleton = m3.pose_skeleton(doc, asset, time) if hasattr(m3, "pose_skeleton") else runtime
@@ -159,7 +166,8 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
                 return m3.set_dof_command(doc, asset, index, a, math.radians(value), t, gesture=gesture)
 
             specs.append(DofSpec(f"rotate {axis}", math.degrees(float(dof.value)), math.degrees(lo),
-                                 math.degrees(hi), set_dof))
+                                 math.degrees(hi), set_dof, "°", m3.dof_channel_id(doc, asset, index, axis),
+                                 math.radians))
         return specs
     return []
 
@@ -383,7 +391,13 @@ class DofPanel(QWidget):
         (arrow keys, page steps and typed values)."""
         self._editing = True
         try:
-            command = spec.make(value, self.ctx.time, None)
+            doc = self.ctx.doc
+            if spec.channel and not autokey(doc):
+                # Auto-key off: pose without keying, like a drag in the editors.
+                command: Command = PosePreview(doc, {spec.channel: spec.to_doc(value)}, self.ctx.time,
+                                               f"Pose {spec.label}", gesture)
+            else:
+                command = spec.make(value, self.ctx.time, None)
             if gesture is not None:
                 gesture.update(command)
             else:

@@ -187,3 +187,33 @@ def test_arrow_keys_move_between_tree_rows_not_frames(make_window, qtbot):
         assert window.ctx.frame == 31, name
         qtbot.keyClick(view, Qt.Key.Key_Down)
         assert window.ctx.frame == window.doc.frame_range[1], name
+
+
+def test_with_auto_key_off_a_dof_slider_drag_poses_without_keying(qtbot, clock):
+    """Auto-key off: the slider shows the pose it was dragged to (the joint's evaluated
+    angle follows) but writes no key and leaves no undo step; another frame discards it."""
+    from qtanimator.document import pose
+
+    window, panel = clock
+    doc = window.doc
+    character = doc.runtime["clock"]
+    joint = 4
+    pose.set_autokey(doc, False)
+    window.ctx.select("clock", character.joints[joint].name)
+    slider = panel.dofs.rows[0].slider
+    qtbot.waitUntil(lambda: slider.isVisible())
+    start = handle_center(slider)
+    channels = {cid: ch.to_dict() for cid, ch in doc.channels.items()}
+    undo_count = window.ctx.undo_stack.count()
+    qtbot.mousePress(slider, Qt.MouseButton.LeftButton, pos=start)
+    for dx in (5, 10, 20):
+        qtbot.mouseMove(slider, start + QPoint(dx, 0))
+    qtbot.mouseRelease(slider, Qt.MouseButton.LeftButton, pos=start + QPoint(20, 0))
+    assert slider.value() > 0
+    assert {cid: ch.to_dict() for cid, ch in doc.channels.items()} == channels   # no key
+    assert window.ctx.undo_stack.count() == undo_count
+    shown = c2d.joint_angles(doc, "clock", window.ctx.time)[joint]
+    assert math.degrees(shown) == pytest.approx(slider.value() / 10.0)
+    window.ctx.set_frame(5.0)
+    window.ctx.set_frame(0.0)
+    assert c2d.joint_angles(doc, "clock", 0.0)[joint] == pytest.approx(0.0)
