@@ -12,7 +12,7 @@ cd "$here"
 SYSTEM_PACKAGES=(python3-venv python3-pip libglib2.0-0 libgl1 libegl1 libgl1-mesa-dri libxkbcommon0
   libfontconfig1 libdbus-1-3 xvfb xauth libxcb-cursor0 libxcb-icccm4 libxcb-keysyms1
   libxcb-render-util0 libxcb-shape0 libxkbcommon-x11-0 libxcb-xinerama0 libxcb-randr0
-  libxcb-image0 libxcb-xfixes0 libxcb-xkb1 libx11-xcb1)
+  libxcb-image0 libxcb-xfixes0 libxcb-xkb1 libx11-xcb1 fonts-dejavu-core)
 
 need_system_packages() {
   command -v dpkg-query >/dev/null 2>&1 || return 1

@@ -171,3 +171,14 @@ def test_onion_skin_opacity_multiplies(qapp) -> None:  # type: ignore[no-untyped
     text = svg('<g opacity="0.5"><rect x="10" y="10" width="100" height="100" fill="black"/></g>')
     full, faint = ours(text), ours(text, opacity=0.5)
     assert 120 <= full[60, 60, 0] <= 135 and 185 <= faint[60, 60, 0] <= 200
+
+
+def test_text_in_the_same_font_on_both_sides_is_drawn_as_resvg_draws_it(qapp) -> None:  # type: ignore[no-untyped-def]
+    """Text drawn by QtSvg and by resvg with the same installed font (DejaVu Sans, which
+    the CI machine has). At 28 px the glyphs agree within the 1% budget; at 20 px the two
+    renderers place glyphs a subpixel apart and about 5% of the ink differs (not asserted)."""
+    text = svg('<rect width="10" height="10"/>'
+               '<text x="10" y="70" font-family="DejaVu Sans" font-size="28" fill="black">Hello</text>')
+    a, b = ours(text), reference(text)
+    assert (a < 128).any(axis=2).sum() > 500      # the word is drawn, not dropped
+    assert differing(a, b) <= 0.01
