@@ -41,6 +41,7 @@ def flag_params() -> ClothParams:
     """A light 1.5 m × 1.0 m flag (16 × 24 particles) whose pinned left edge stands at
     x = −2.9, left of the arm, flying towards +x in a steady breeze with mild gusts."""
     return ClothParams(
+        integrator="symplectic",
         rows=FLAG_ROWS, cols=FLAG_COLS, width=FLAG_WIDTH, height=1.0, total_mass=0.35,
         structural_stiffness=150.0, structural_damping=0.15,
         shear_stiffness=60.0, shear_damping=0.08,

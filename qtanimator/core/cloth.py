@@ -25,18 +25,34 @@ Model
 
 Integration
 -----------
-* ``"symplectic"``: semi-implicit Euler (``v += a·h; x += v·h``) with ``substeps`` per frame.
-  The springs live on a regular grid, so every spring family is a pair of slices of the flat
-  particle array (offset 1, cols, cols ± 1, 2, 2·cols): gather and scatter are slice
-  arithmetic, no index arrays, no per-particle Python loop. When numba is installed the
-  spring and drag forces come from compiled kernels (:mod:`qtanimator.core.cloth_kernels`,
-  ~10× faster, tested against the numpy code); ``Cloth(params, accelerate=False)`` forces numpy.
-* ``"implicit"``: backward Euler linearised once per step (Baraff & Witkin 1998): solve
-  ``(M − h·∂f/∂v − h²·∂f/∂x)·Δv = h·(f + h·∂f/∂x·v)`` with a block-sparse (3×3 BSR) matrix and
-  Jacobi-preconditioned conjugate gradients on the scipy.sparse matrix (our own short loop with
-  einsum dot products: a threaded BLAS dot stalls on a loaded machine). Compressed springs drop their
-  transverse stiffness so the matrix stays positive definite. Stable at ``dt = 1/60`` with
-  one substep for stiffness up to 1e4 N/m.
+* ``"implicit"`` (the default): backward Euler linearised once per step (Baraff & Witkin
+  1998): solve ``(M − h·∂f/∂v − h²·∂f/∂x)·Δv = h·(f + h·∂f/∂x·v)``. Springs and their damping
+  are implicit, drag and gravity explicit; compressed springs drop their transverse stiffness
+  so the matrix stays positive definite. Pins and the grabbed particle are constraints of the
+  solve (identity rows and columns, zero right-hand side). The block-CSR sparsity pattern is
+  built once per grid; with numba every step writes the matrix values straight into it and
+  solves with a compiled block-Jacobi conjugate gradient (:mod:`qtanimator.core.cloth_kernels`),
+  without numba the same system is assembled with numpy / scipy.sparse and solved by the same
+  CG in numpy (5-7× slower; ``cloth_kernels.SLOW_PATH_NOTE`` says so). The CG starts from the
+  previous step's velocity change and stops at ``|r| ≤ max(rtol·|b|, atol)`` with
+  ``rtol`` = :data:`SOLVER_RTOL` (1e-3: over 250 frames of the 2 m benchmark cloth the
+  positions stay within about 1 mm of a solve to 1e-9) and ``atol`` =
+  :data:`SOLVER_ATOL_ACCELERATION` × h × particle mass × √N (every eigenvalue of the matrix
+  is at least the particle mass, so the RMS error of the velocity change stays below
+  1e-3 m/s² × h: a settled cloth does not chase ever smaller residuals), or after
+  ``max(200, 8·√N)`` iterations. Stable for every
+  stiffness and damping the cloth panel allows; large steps damp fast motion (backward Euler
+  loses energy), so :data:`IMPLICIT_MAX_STEP` caps the automatic step.
+* ``"symplectic"``: semi-implicit Euler (``v += a·h; x += v·h``), accurate and cheap per
+  substep but only stable below a step that shrinks with stiffness and damping and with
+  lighter particles (finer grids). The springs live on a regular grid, so every spring
+  family is a pair of slices of the flat particle array (offset 1, cols, cols ± 1, 2, 2·cols):
+  gather and scatter are slice arithmetic, no index arrays, no per-particle Python loop. When
+  numba is installed the spring and drag forces come from compiled kernels (~10× faster,
+  tested against the numpy code); ``Cloth(params, accelerate=False)`` forces numpy.
+* ``substeps`` = 0 (the default, "auto") picks the steps per frame: the fewest that keep the
+  implicit step at most :data:`IMPLICIT_MAX_STEP`, or the symplectic substep inside its
+  stability bound (:meth:`Cloth.stable_substeps`). A number set by hand is used as it is.
 
 A step that produces non-finite or runaway values is undone and raises :class:`ClothBlowUp`,
 whose message names the parameter to change; the cloth stays stopped (``cloth.error``) until
@@ -61,7 +77,8 @@ IntArray = npt.NDArray[np.int64]
 BoolArray = npt.NDArray[np.bool_]
 
 __all__ = [
-    "INTEGRATORS", "PARAM_RANGES", "PIN_MODES", "SPRING_KINDS", "Cloth", "ClothBlowUp", "ClothParams", "ClothState",
+    "AUTO_SUBSTEPS", "IMPLICIT_MAX_STEP", "INTEGRATORS", "MAX_AUTO_SUBSTEPS", "PARAM_RANGES", "PIN_MODES",
+    "SOLVER_ATOL_ACCELERATION", "SOLVER_RTOL", "SPRING_KINDS", "Cloth", "ClothBlowUp", "ClothParams", "ClothState",
     "ClothStepCancelled", "Sphere", "grid_index", "nearest_particle", "pins_from_cells", "rotation_matrix",
     "vertex_normals",
 ]
@@ -77,8 +94,21 @@ PARAM_RANGES: dict[str, tuple[float, float]] = {
     "structural_damping": (0.0, 50.0), "shear_damping": (0.0, 50.0), "bend_damping": (0.0, 50.0),
     "drag_coefficient": (0.0, 2.0), "air_density": (0.0, 2.0), "turbulence": (0.0, 20.0), "gravity": (0.0, 20.0),
     "ground_height": (-10.0, 10.0), "ground_restitution": (0.0, 1.0), "ground_friction": (0.0, 2.0),
-    "collision_margin": (0.0, 0.1), "substeps": (1, 200),
+    "collision_margin": (0.0, 0.1), "substeps": (0, 200),
 }
+
+#: ``substeps`` = AUTO_SUBSTEPS lets the cloth choose its steps per frame (see the module docstring).
+AUTO_SUBSTEPS = 0
+#: Longest automatic implicit step (s): one step a frame at 60 fps, 2 at 30 fps, 3 at 24 fps.
+IMPLICIT_MAX_STEP = 1.0 / 60.0
+#: The most substeps "auto" gives the symplectic integrator; settings that need more raise
+#: ClothBlowUp before stepping, naming the implicit integrator.
+MAX_AUTO_SUBSTEPS = 5000
+#: The implicit solver's relative tolerance on the residual (see the module docstring).
+SOLVER_RTOL = 1.0e-3
+#: The solver's absolute floor as an RMS acceleration error (m/s², a ten-thousandth of g):
+#: a settled cloth does not chase ever smaller residuals.
+SOLVER_ATOL_ACCELERATION = 1.0e-3
 
 #: Speeds above this (m/s) count as a blow-up even while the numbers are still finite.
 RUNAWAY_SPEED = 1.0e4
@@ -154,8 +184,8 @@ class ClothParams:
     collision_margin: float = 0.005
     pin_mode: str = "top_corners"
     custom_pins: list[int] = field(default_factory=list)
-    integrator: str = "symplectic"
-    substeps: int = 16
+    integrator: str = "implicit"
+    substeps: int = AUTO_SUBSTEPS
     origin: Vec3 = (0.0, 2.0, 0.0)
     orientation: Vec3 = (0.0, 0.0, 0.0)
 
@@ -222,8 +252,8 @@ class ClothParams:
             raise ValueError(f"pin_mode must be one of {', '.join(PIN_MODES)}, not {self.pin_mode!r}")
         if self.integrator not in INTEGRATORS:
             raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}, not {self.integrator!r}")
-        if self.substeps < 1:
-            raise ValueError("substeps must be at least 1")
+        if self.substeps < 0:
+            raise ValueError("substeps must be 0 (automatic) or a positive number")
         n = self.rows * self.cols
         for i in self.custom_pins:
             if not 0 <= i < n:
@@ -251,6 +281,8 @@ _VEC_FIELDS = {"wind", "origin", "orientation"}
 
 
 def _coerce(name: str, value: Any) -> Any:
+    if name == "substeps" and isinstance(value, str) and value.strip().lower() == "auto":
+        return AUTO_SUBSTEPS
     if name in _INT_FIELDS:
         if isinstance(value, bool) or not float(value).is_integer():
             raise ValueError(f"{name} must be a whole number")
@@ -293,7 +325,10 @@ class ClothStepCancelled(Exception):
 
 @dataclass
 class ClothState:
-    """Everything that evolves: enough to resume a simulation exactly (caches keep these)."""
+    """Everything that evolves: enough to resume a simulation exactly (caches keep these).
+
+    ``solver_start`` is the implicit solver's last velocity change, where its next solve
+    starts (None: from zero); it is part of the state so that resuming gives identical frames."""
 
     positions: FloatArray
     velocities: FloatArray
@@ -301,10 +336,12 @@ class ClothState:
     time: float
     grabbed: int | None = None
     grab_target: FloatArray | None = None
+    solver_start: FloatArray | None = None
 
     def copy(self) -> ClothState:
         return ClothState(self.positions.copy(), self.velocities.copy(), self.pin_targets.copy(), self.time,
-                          self.grabbed, None if self.grab_target is None else self.grab_target.copy())
+                          self.grabbed, None if self.grab_target is None else self.grab_target.copy(),
+                          None if self.solver_start is None else self.solver_start.copy())
 
 
 def rotation_matrix(rotation: Any) -> FloatArray:
@@ -344,6 +381,13 @@ class Cloth:
                                                                                    cloth_kernels.HAVE_NUMBA)
         self.params.validate()
         self.error: ClothBlowUp | None = None
+        #: The implicit solver's stopping rule (module docstring); tests tighten it.
+        self.solver_rtol = SOLVER_RTOL
+        self.solver_atol_acceleration = SOLVER_ATOL_ACCELERATION
+        #: Start each implicit solve from the previous step's velocity change (else from zero).
+        self.warm_start = True
+        #: Conjugate-gradient iterations of the last implicit substep (for benchmarks and tests).
+        self.last_iterations = 0
         self._build()
         self.reset()
 
@@ -431,6 +475,8 @@ class Cloth:
         self._turb_w = rng.uniform(0.5, 3.0, size=(4, 3)) * 2 * math.pi  # angular frequencies, rad/s
         self._turb_phase = rng.uniform(0.0, 2 * math.pi, size=(4, 3))
         self._implicit_cache: dict[str, Any] | None = None
+        self._stable_dt_cache: float | None = None
+        self._solver_start: FloatArray = np.zeros((n, 3))
         self._air: FloatArray | None = None
         self._wind_cache: FloatArray | None = None
         self._inv_mass_h: tuple[float, FloatArray] | None = None
@@ -463,6 +509,7 @@ class Cloth:
         self.time = 0.0
         self.grabbed: int | None = None
         self._grab_target: FloatArray | None = None
+        self._solver_start = np.zeros((self.n, 3))
         self.error = None
 
     def _assign(self, positions: FloatArray, velocities: FloatArray) -> None:
@@ -475,7 +522,8 @@ class Cloth:
     def state(self) -> ClothState:
         """A copy of everything that evolves."""
         return ClothState(self.positions.copy(), self.velocities.copy(), self.pin_targets.copy(), self.time,
-                          self.grabbed, None if self._grab_target is None else self._grab_target.copy())
+                          self.grabbed, None if self._grab_target is None else self._grab_target.copy(),
+                          self._solver_start.copy())
 
     def set_state(self, state: ClothState) -> None:
         """Resume from a state taken from a cloth with the same grid and pins."""
@@ -488,6 +536,11 @@ class Cloth:
         self.time = float(state.time)
         self.grabbed = state.grabbed
         self._grab_target = None if state.grab_target is None else np.array(state.grab_target, dtype=np.float64)
+        start = state.solver_start
+        if start is None or np.shape(start) != (self.n, 3):
+            self._solver_start = np.zeros((self.n, 3))
+        else:
+            self._solver_start = np.array(start, dtype=np.float64)
         self.error = None
 
     def set_params(self, params: ClothParams) -> bool:
@@ -509,8 +562,10 @@ class Cloth:
             return True
         saved = self.state()
         old_pins = self._pin_index
+        pattern = self._implicit_cache  # the matrix pattern depends on the grid only
         self.params = params
         self._build()
+        self._implicit_cache = pattern
         if not np.array_equal(old_pins, self._pin_index):
             saved.pin_targets = saved.positions[self._pin_index].copy()
             if saved.grabbed is not None and self.pinned[saved.grabbed]:
@@ -542,7 +597,34 @@ class Cloth:
     def stable_substeps(self, frame_dt: float = 1.0 / 60.0) -> int:
         """Fewest symplectic substeps per frame the stability estimate allows."""
         limit = self._stable_dt()
-        return max(1, math.ceil(frame_dt / limit))
+        if not math.isfinite(limit):
+            return 1
+        # The small allowance keeps 1/60 ÷ (1/120) at 2, not 3, after rounding.
+        return max(1, math.ceil(frame_dt / limit - 1e-9))
+
+    def substeps_for(self, frame_dt: float) -> int:
+        """The steps a frame of ``frame_dt`` seconds takes: ``params.substeps`` when set by hand,
+        else the automatic choice for the integrator (see the module docstring)."""
+        p = self.params
+        if p.substeps > 0:
+            return p.substeps
+        if p.integrator == "implicit":
+            # Drag is explicit in the implicit step: very light cloth in strong wind needs more steps.
+            rate = self._drag_rate()
+            longest = IMPLICIT_MAX_STEP if rate <= 0 else min(IMPLICIT_MAX_STEP, 0.9 * 2.0 / rate)
+            return max(1, math.ceil(frame_dt / longest - 1e-9))
+        return self.stable_substeps(frame_dt)
+
+    def _drag_rate(self) -> float:
+        """A bound on the drag's ∂f/∂v ÷ m (1/s), Gershgorin over a particle's six triangles:
+        each triangle's drag changes by at most 2·½ρc_d·|w|·area per m/s of its mean relative
+        velocity ``w``, with |w| at most the wind, plus the gusts, plus 5 m/s of the cloth's own."""
+        p = self.params
+        if p.drag_coefficient <= 0 or p.air_density <= 0:
+            return 0.0
+        speed = float(np.linalg.norm(p.wind)) + 5.0 * p.turbulence + 5.0
+        area = p.width * p.height / (2.0 * (self.rows - 1) * (self.cols - 1))
+        return 4.0 * 0.5 * p.air_density * p.drag_coefficient * speed * area / self.particle_mass
 
     def _stable_dt(self) -> float:
         """Longest stable symplectic substep, estimated from the rest configuration.
@@ -550,7 +632,13 @@ class Cloth:
         Gershgorin bounds per particle and axis on the largest eigenvalues λ_K of M⁻¹K and λ_C of
         M⁻¹C (springs act along their direction u: row a gets Σ k·|u_a|·Σ_b|u_b| from both ends),
         then the damped-oscillator condition of semi-implicit Euler, h²·λ_K/4 + h·λ_C/2 ≤ 1.
+        Drag acts like damping and adds :meth:`_drag_rate` to λ_C.
         """
+        if self._stable_dt_cache is None:
+            self._stable_dt_cache = self._compute_stable_dt()
+        return self._stable_dt_cache
+
+    def _compute_stable_dt(self) -> float:
         i, j = self.springs[:, 0], self.springs[:, 1]
         d = self.rest_positions[j] - self.rest_positions[i]
         u = np.abs(d / np.linalg.norm(d, axis=1)[:, None])
@@ -561,6 +649,7 @@ class Cloth:
             for a in range(3):
                 rows[:, a] = np.bincount(i, coef * w[:, a], self.n) + np.bincount(j, coef * w[:, a], self.n)
             lam.append(2.0 * float(rows.max()) / self.particle_mass)
+        lam[1] += self._drag_rate()
         qa, qb = lam[0] / 4.0, lam[1] / 2.0
         if qa <= 0 and qb <= 0:
             return math.inf
@@ -627,7 +716,7 @@ class Cloth:
 
     # ----------------------------------------------------------- simulation
     def step(self, dt: float = 1.0 / 60.0, should_stop: Callable[[], bool] | None = None) -> None:
-        """Advance one display frame of ``dt`` seconds (``params.substeps`` substeps inside).
+        """Advance one display frame of ``dt`` seconds (:meth:`substeps_for` substeps inside).
 
         Raises ClothBlowUp (and keeps the state from before the frame) when the simulation
         goes unstable; raises it again on every later step until reset. ``should_stop`` is
@@ -639,9 +728,12 @@ class Cloth:
             raise self.error
         if not dt > 0:
             raise ValueError("dt must be positive")
+        substeps = self.substeps_for(dt)
+        if substeps > MAX_AUTO_SUBSTEPS and self.params.substeps == AUTO_SUBSTEPS:
+            self.error = self._too_many_substeps_error(dt, substeps)
+            raise self.error
         saved = self.state()
         kin_idx, kin_start, kin_end = self._kinematics()
-        substeps = self.params.substeps
         h = dt / substeps
         kin_vel = (kin_end - kin_start) / dt
         # The turbulent wind field is sampled at the particles once per frame (gusts are ≤ 3 Hz).
@@ -664,7 +756,7 @@ class Cloth:
         if bad:
             blow_time = self.time
             self.set_state(saved)
-            self.error = self._blow_up_error(dt, blow_time)
+            self.error = self._blow_up_error(dt, substeps, blow_time)
             raise self.error
 
     def _kinematics(self) -> tuple[IntArray, FloatArray, FloatArray]:
@@ -694,14 +786,15 @@ class Cloth:
         coef = 0.5 * p.air_density * p.drag_coefficient
         if coef <= 0:
             return
+        if self.accelerated:
+            air = self._air if self._air is not None else self._wind_field()
+            cloth_kernels.drag_forces(x, v, air, self.triangles, coef, force)
+            return
         # Velocity relative to the air at each particle; a triangle's is the mean of its corners'.
         if self._air is not None:
             rel = v - self._air
         else:
             rel = v - np.asarray(p.wind, dtype=np.float64)
-        if self.accelerated:
-            cloth_kernels.drag_forces(x, rel, self.triangles, coef, force)
-            return
         R, C = self.rows, self.cols
         x2 = x.reshape(R, C, 3)
         r2 = rel.reshape(R, C, 3)
@@ -781,10 +874,12 @@ class Cloth:
 
     # ----------------------------------------------------------- implicit
     def _implicit_setup(self) -> dict[str, Any]:
+        """The block-CSR pattern of the implicit matrix (built once per grid) and work arrays.
+
+        Row i holds blocks (i, i) and (i, j) for every spring touching i, columns sorted;
+        ``slot_diag[i]``, ``slot_ij[s]``, ``slot_ji[s]`` say where each spring writes."""
         if self._implicit_cache is not None:
             return self._implicit_cache
-        import scipy.sparse as sp  # only the implicit integrator needs it
-
         n = self.n
         si, sj = self.springs[:, 0], self.springs[:, 1]
         ns = len(si)
@@ -795,28 +890,56 @@ class Cloth:
         slot = np.empty_like(order)
         slot[order] = np.arange(len(order))
         indptr = np.concatenate([[0], np.cumsum(np.bincount(rows, minlength=n))]).astype(np.int64)
-        indices = cols[order].astype(np.int64)
-        incidence = sp.csr_matrix((np.ones(2 * ns), (np.concatenate([si, sj]), np.concatenate([np.arange(ns)] * 2))),
-                                  shape=(n, ns))
-        self._implicit_cache = {
-            "slot_diag": slot[:n], "slot_ij": slot[n:n + ns], "slot_ji": slot[n + ns:],
-            "indptr": indptr, "indices": indices, "incidence": incidence, "nblocks": len(order),
-            "bsr_matrix": sp.bsr_matrix,
+        indices = np.ascontiguousarray(cols[order].astype(np.int64))
+        nblocks = len(order)
+        cache: dict[str, Any] = {
+            "slot_diag": np.ascontiguousarray(slot[:n]), "slot_ij": np.ascontiguousarray(slot[n:n + ns]),
+            "slot_ji": np.ascontiguousarray(slot[n + ns:]), "indptr": indptr, "indices": indices,
+            "nblocks": nblocks, "data": np.zeros((nblocks, 9)), "pre": np.zeros((n, 6)), "rhs": np.zeros((n, 3)),
+            "work": [np.zeros((n, 3)) for _ in range(4)],
+            "maxiter": max(200, 8 * int(math.sqrt(n))),
         }
-        return self._implicit_cache
+        if not self.accelerated:
+            import scipy.sparse as sp  # only the numpy implicit path needs it
+
+            cache["incidence"] = sp.csr_matrix(
+                (np.ones(2 * ns), (np.concatenate([si, sj]), np.concatenate([np.arange(ns)] * 2))), shape=(n, ns))
+            cache["bsr_matrix"] = sp.bsr_matrix
+        self._implicit_cache = cache
+        return cache
 
     def _implicit_substep(self, h: float, kin_idx: IntArray, kin_pos: FloatArray, kin_vel: FloatArray) -> None:
         cache = self._implicit_setup()
         n = self.n
-        x, v = self.positions, self.velocities
-        v[kin_idx] = kin_vel
         free = np.ones(n, dtype=bool)
         free[kin_idx] = False
+        atol = self.solver_atol_acceleration * h * self.particle_mass * math.sqrt(n)
+        dv = self._solver_start
+        if self.accelerated:
+            p = self.params
+            air = self._air if self._air is not None else self._wind_field()
+            r, z, d, ad = cache["work"]
+            self.last_iterations = cloth_kernels.implicit_substep(
+                self.positions, self.velocities, air, self._si, self._sj, self.rest_lengths, self._spring_k,
+                self._spring_c, self.triangles, 0.5 * p.air_density * p.drag_coefficient,
+                p.gravity * self.particle_mass, self.particle_mass, h, kin_idx, np.ascontiguousarray(kin_pos),
+                np.ascontiguousarray(kin_vel), free, cache["indptr"], cache["indices"], cache["slot_diag"],
+                cache["slot_ij"], cache["slot_ji"], cache["data"], cache["pre"], cache["rhs"], self._force, dv,
+                r, z, d, ad, self.solver_rtol, atol, cache["maxiter"], self.warm_start)
+            self._collide(kin_idx)
+            return
+        self._implicit_substep_numpy(h, kin_idx, kin_pos, kin_vel, free, atol, cache)
 
+    def _implicit_substep_numpy(self, h: float, kin_idx: IntArray, kin_pos: FloatArray, kin_vel: FloatArray,
+                                free: BoolArray, atol: float, cache: dict[str, Any]) -> None:
+        """The same step as the compiled kernel, vectorised (the fallback without numba)."""
+        n = self.n
+        x, v = self.positions, self.velocities
+        v[kin_idx] = kin_vel
         force = self._external_forces(x, v)
         self._spring_forces(x, v, force)
 
-        si, sj = self.springs[:, 0], self.springs[:, 1]
+        si, sj = self._si, self._sj
         k, c, rest = self._spring_k, self._spring_c, self.rest_lengths
         d = x[sj] - x[si]
         ln = np.sqrt(np.einsum("ij,ij->i", d, d))
@@ -851,8 +974,12 @@ class Cloth:
             kv[:, comp] = np.bincount(si, kdv[:, comp], n) - np.bincount(sj, kdv[:, comp], n)
         rhs = h * (force + h * kv)
         rhs[~free] = 0.0
-        sol = _pcg(a, rhs.ravel(), 1.0 / a.diagonal(), rtol=1e-6, maxiter=max(200, 8 * int(math.sqrt(n))))
-        v += sol.reshape(n, 3)
+        with np.errstate(all="ignore"):
+            pre = np.linalg.inv(diag) if np.isfinite(diag).all() else np.full_like(diag, np.nan)
+        start = self._solver_start
+        self.last_iterations = _pcg(a, rhs.ravel(), pre, start.reshape(-1), self.solver_rtol, atol,
+                                    cache["maxiter"], self.warm_start)
+        v += start
         v[kin_idx] = kin_vel
         x += v * h
         x[kin_idx] = kin_pos
@@ -907,27 +1034,34 @@ class Cloth:
         v[idx] = vt * keep[:, None] + vn_new[:, None] * normal
 
     # ------------------------------------------------------------ blow-ups
-    def _blow_up_error(self, dt: float, when: float) -> ClothBlowUp:
+    def _too_many_substeps_error(self, dt: float, substeps: int) -> ClothBlowUp:
+        msg = (f"The symplectic integrator would need {substeps} substeps for each {dt * 1000:.3g} ms frame "
+               f"with these springs (more than {MAX_AUTO_SUBSTEPS}). Set 'integrator' to 'implicit', or lower "
+               f"the stiffness or the damping, or raise 'total_mass'.")
+        return ClothBlowUp(msg, "integrator", self.time)
+
+    def _blow_up_error(self, dt: float, substeps: int, when: float) -> ClothBlowUp:
         p = self.params
-        h = dt / p.substeps
+        h = dt / substeps
         if p.integrator == "symplectic":
             limit = self._stable_dt()
-            need = math.ceil(p.substeps * h / limit) if limit < math.inf else p.substeps
+            need = math.ceil(substeps * h / limit) if limit < math.inf else substeps
             ks = {kind: p.stiffness(kind) for kind in SPRING_KINDS}
             stiffest = max(ks, key=lambda kd: ks[kd])
             if h > limit:
                 msg = (f"The cloth simulation blew up at t = {when:.3f} s: a symplectic substep of "
                        f"{h * 1000:.3g} ms is too long for {stiffest} stiffness {ks[stiffest]:g} N/m on "
                        f"{self.particle_mass:.3g} kg particles (stable below about {limit * 1000:.3g} ms). "
-                       f"Raise 'substeps' to at least {max(need, p.substeps + 1)}, lower '{stiffest}_stiffness' "
+                       f"Raise 'substeps' to at least {max(need, substeps + 1)} (or 0, automatic), "
+                       f"lower '{stiffest}_stiffness' "
                        f"or the damping, raise 'total_mass', or set 'integrator' to 'implicit'.")
                 return ClothBlowUp(msg, "substeps", when)
             msg = (f"The cloth simulation blew up at t = {when:.3f} s although the substep looks stable; "
-                   f"the forces are too strong for {p.substeps} substeps. Raise 'substeps', lower 'wind' or "
+                   f"the forces are too strong for {substeps} substeps. Raise 'substeps', lower 'wind' or "
                    f"'turbulence' or 'drag_coefficient', or set 'integrator' to 'implicit'.")
             return ClothBlowUp(msg, "substeps", when)
         msg = (f"The implicit cloth solver blew up at t = {when:.3f} s. Lower 'wind', 'turbulence' or "
-               f"'drag_coefficient', or raise 'substeps' (now {p.substeps}).")
+               f"'drag_coefficient', or raise 'substeps' (now {substeps} a frame).")
         return ClothBlowUp(msg, "wind", when)
 
 
@@ -936,31 +1070,49 @@ def _dot(a: FloatArray, b: FloatArray) -> float:
     return float(np.einsum("i,i->", a, b))
 
 
-def _pcg(a: Any, b: FloatArray, inv_diag: FloatArray, rtol: float, maxiter: int) -> FloatArray:
-    """Jacobi-preconditioned conjugate gradients from x = 0, stopping at |r| ≤ rtol·|b|."""
-    x = np.zeros_like(b)
-    r = b.copy()
-    target = rtol * math.sqrt(_dot(b, b))
-    if target == 0.0:
-        return x
+def _pcg(a: Any, b: FloatArray, pre: FloatArray, x: FloatArray, rtol: float, atol: float, maxiter: int,
+         warm: bool) -> int:
+    """Conjugate gradients on ``a·x = b``, preconditioned with ``pre`` (the inverse 3×3
+    diagonal blocks, (N, 3, 3)), in place on ``x``: from ``x`` when ``warm`` else from zero,
+    until ``|r| ≤ max(rtol·|b|, atol)`` or ``maxiter`` iterations. The numpy twin of
+    ``cloth_kernels.block_pcg``; returns the iterations done (−1 when ``b`` is not finite)."""
+    n = len(pre)
+
+    def precondition(r: FloatArray) -> FloatArray:
+        return np.einsum("nij,nj->ni", pre, r.reshape(n, 3)).reshape(-1)
+
+    target = max(rtol * math.sqrt(_dot(b, b)), atol)
     if not math.isfinite(target):
-        return np.full_like(b, np.nan)  # the step is already lost; the caller reports the blow-up
-    z = r * inv_diag
+        x[:] = np.nan  # the step is already lost; the caller reports the blow-up
+        return -1
+    if warm:
+        r = b - a @ x
+    else:
+        x[:] = 0.0
+        r = b.copy()
+    if target == 0.0 or math.sqrt(_dot(r, r)) <= target:
+        return 0
+    z = precondition(r)
     p = z.copy()
     rz = _dot(r, z)
-    for _ in range(maxiter):
+    it = 0
+    while it < maxiter:
+        it += 1
         ap = a @ p
-        alpha = rz / _dot(p, ap)
+        pap = _dot(p, ap)
+        if not pap > 0.0:
+            break
+        alpha = rz / pap
         x += alpha * p
         r -= alpha * ap
         if math.sqrt(_dot(r, r)) <= target:
             break
-        z = r * inv_diag
+        z = precondition(r)
         rz_new = _dot(r, z)
         p *= rz_new / rz
         p += z
         rz = rz_new
-    return x
+    return it
 
 
 def vertex_normals(positions: FloatArray, triangles: IntArray, fallback: Any = (0.0, 0.0, 1.0)) -> FloatArray:

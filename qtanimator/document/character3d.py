@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import os
 from collections.abc import Hashable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -44,7 +44,7 @@ from qtanimator.document.document import Asset, Document, channel_id
 from qtanimator.document.pose import pending_values
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.attach import load_attach
-from qtanimator.formats.bvh import load_bvh
+from qtanimator.formats.bvh import POSITION_CONVENTIONS, load_bvh
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.obj import Mesh, load_obj
 from qtanimator.formats.skel import load_skel
@@ -57,9 +57,10 @@ ROOT_DOFS = ("tx", "ty", "tz")
 JOINT_DOFS = ("rx", "ry", "rz")
 
 __all__ = [
-    "ASSET_KIND", "Character3D", "add_character3d_command", "channel_dofs", "channel_ids", "character",
-    "clip_from_document", "dof_channel_id", "dof_values", "ik_values", "load_bvh_character",
-    "load_anim_command", "load_character3d", "load_character3d_asset", "pose_skeleton", "set_dof_command",
+    "ASSET_KIND", "BVH_POSITIONS", "BvhCharacter", "Character3D", "add_character3d_command", "bvh_positions",
+    "bvh_positions_note", "channel_dofs", "channel_ids", "character", "clip_from_document", "dof_channel_id",
+    "dof_values", "ik_values", "load_anim_command", "load_bvh_character", "load_character3d",
+    "load_character3d_asset", "pose_skeleton", "set_bvh_positions_command", "set_dof_command",
     "set_dofs_command", "skinned_mesh", "world_matrices",
 ]
 
@@ -112,16 +113,40 @@ def load_character3d(skel_path: str | os.PathLike[str], skin_path: str | os.Path
     return Character3D(skeleton, skin, mesh, clip, faceted)
 
 
-def load_bvh_character(path: str | os.PathLike[str]) -> tuple[Character3D, list[Channel | None]]:
+@dataclass(eq=False)
+class BvhCharacter(Character3D):
+    """A character read from a ``.bvh`` file: the position convention it is posed with, the
+    one detected in the file, and notes for the user (the convention, ignored rows)."""
+
+    positions: str = "relative"
+    detected: str = "relative"
+    notes: list[str] = field(default_factory=list)
+
+
+#: The asset property holding a BVH character's position convention (absent: detected).
+BVH_POSITIONS = "bvh_positions"
+
+
+def load_bvh_character(path: str | os.PathLike[str],
+                       positions: str | None = None) -> tuple[BvhCharacter, list[Channel | None]]:
     """A character from a ``.bvh`` file and its motion as channels in the ``.anim`` layout
     (root x, y, z, then x, y, z rotation per joint; None where the file has no channel).
 
+    ``positions`` is the position convention (``"relative"`` or ``"absolute"``, see
+    :mod:`qtanimator.formats.bvh`); None uses the one detected in the file. The channels hold
+    the file's numbers either way: the convention only sets the offsets (absolute: the
+    root's OFFSET is 0 on its position axes, so the channel replaces it).
+
     The skeleton's DOFs hold the first frame's pose. Raises FormatError for a bad file or a
-    hierarchy a skeleton cannot hold (several roots, position channels below the root).
+    hierarchy a skeleton cannot hold (several roots, a joint below the root that moves).
     """
     clip = load_bvh(path)
+    if positions is not None and positions not in POSITION_CONVENTIONS:
+        raise FormatError(f"unknown BVH position convention {positions!r}; expected 'relative' or "
+                          "'absolute'.", path)
+    chosen = positions or clip.positions
     try:
-        skeleton, channels = clip.to_skeleton()
+        skeleton, channels = clip.to_skeleton(chosen)
     except ValueError as exc:
         raise FormatError(f"{exc}.", path) from exc
     skeleton.dialect = "bvh"
@@ -129,7 +154,68 @@ def load_bvh_character(path: str | os.PathLike[str]) -> tuple[Character3D, list[
         # BVH has no boxes: default boxes make the viewport draw spheres and bones.
         joint.boxmin = np.array(DEFAULT_BOXMIN)
         joint.boxmax = np.array(DEFAULT_BOXMAX)
-    return Character3D(skeleton), channels
+    notes = [bvh_positions_note(chosen, clip.positions), *clip.warnings]
+    return BvhCharacter(skeleton, positions=chosen, detected=clip.positions, notes=notes), channels
+
+
+def bvh_positions_note(chosen: str, detected: str) -> str:
+    """The import message's sentence on the position convention."""
+    what = ("root positions replace the root's OFFSET (absolute, as Blender writes them)" if chosen == "absolute"
+            else "root positions are added to the root's OFFSET (relative)")
+    how = "detected in the file" if chosen == detected else f"chosen; the file looks {detected}"
+    return f"BVH positions: {what}, {how}; switch in Properties."
+
+
+def bvh_positions(doc: Document, asset_id: str) -> str | None:
+    """The position convention a BVH character is posed with, None for other characters."""
+    asset = doc.assets.get(asset_id)
+    if asset is None or asset.kind != ASSET_KIND or Path(asset.source or "").suffix.lower() != ".bvh":
+        return None
+    value = asset.properties.get(BVH_POSITIONS)
+    if value in POSITION_CONVENTIONS:
+        return str(value)
+    rt = doc.runtime.get(asset_id)
+    return rt.positions if isinstance(rt, BvhCharacter) else None
+
+
+class _SetBvhPositions(Command):
+    """Switch a BVH character's position convention: the asset property and the loaded
+    skeleton's offsets change together; the channels (the file's numbers) stay."""
+
+    def __init__(self, doc: Document, asset_id: str, value: str, runtime: BvhCharacter) -> None:
+        self.asset_id = asset_id
+        self.old_asset = doc.assets[asset_id]
+        self.old_runtime = doc.runtime.get(asset_id)
+        self.new_asset = self.old_asset.copy()
+        self.new_asset.properties[BVH_POSITIONS] = value
+        self.new_runtime = runtime
+        self.text = f"BVH positions: {value}"
+
+    def do(self, doc: Document) -> None:
+        doc.apply_asset(self.asset_id, self.new_asset, self.new_runtime)
+
+    def undo(self, doc: Document) -> None:
+        doc.apply_asset(self.asset_id, self.old_asset, self.old_runtime)
+
+
+def set_bvh_positions_command(doc: Document, asset_id: str, value: str) -> Command:
+    """One undo step that poses a BVH character with the position convention ``value``
+    (``"relative"`` or ``"absolute"``). Reads the file again (FormatError if it is gone)."""
+    if value not in POSITION_CONVENTIONS:
+        raise ValueError(f"unknown BVH position convention {value!r}")
+    asset = doc.assets[asset_id]
+    if asset.kind != ASSET_KIND or not asset.source or Path(asset.source).suffix.lower() != ".bvh":
+        raise ValueError(f"{asset_id!r} is not a BVH character")
+    runtime, _ = load_bvh_character(asset.source, value)
+    old = doc.runtime.get(asset_id)
+    if isinstance(old, Character3D):
+        # Keep what the user gave the character since (a skin): only the offsets change.
+        skeleton = old.skeleton.copy()
+        for joint, new in zip(skeleton.joints, runtime.skeleton.joints):
+            joint.offset = new.offset.copy()
+        runtime = BvhCharacter(skeleton, old.skin, old.mesh, old.clip, old.faceted, positions=value,
+                               detected=runtime.detected, notes=runtime.notes)
+    return _SetBvhPositions(doc, asset_id, value, runtime)
 
 
 def load_character3d_asset(asset: Asset) -> Character3D:
@@ -138,7 +224,8 @@ def load_character3d_asset(asset: Asset) -> Character3D:
         raise FormatError(f"3D character {asset.id!r} has no skeleton file.")
     suffix = Path(asset.source).suffix.lower()
     if suffix == ".bvh":
-        return load_bvh_character(asset.source)[0]
+        value = asset.properties.get(BVH_POSITIONS)
+        return load_bvh_character(asset.source, value if value in POSITION_CONVENTIONS else None)[0]
     if suffix in (".glb", ".gltf"):
         from qtanimator.document.import3d import load_gltf_character_asset
 

@@ -50,6 +50,7 @@ from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skel
 from qtanimator.core.skinning import Skin, SkinBinding
 from qtanimator.document.character3d import (
     ASSET_KIND,
+    BVH_POSITIONS,
     Character3D,
     _channel_ids,
     add_character3d_command,
@@ -271,10 +272,12 @@ def bvh_import(doc: Document, path: str | os.PathLike[str]) -> Import:
     aid = doc.unique_asset_id(_asset_base(p))
     ids = _channel_ids(aid, runtime.skeleton.joint_keys())
     channels = {cid: ch for cid, ch in zip(ids, chans) if ch is not None}
-    asset = Asset(aid, ASSET_KIND, str(p.resolve()), {})
+    # The root-position convention detected (or chosen later in Properties) is saved with
+    # the asset; the notes say which one was used and what was ignored.
+    asset = Asset(aid, ASSET_KIND, str(p.resolve()), {BVH_POSITIONS: runtime.positions})
     add = AddAsset(asset, runtime, channels, text=f"Add 3D character {aid}")
     n = max((len(c.keys) for c in channels.values()), default=0)
-    notes = [f"{len(runtime.skeleton.joints)} joints, {n} frames."]
+    notes = [f"{len(runtime.skeleton.joints)} joints, {n} frames.", *runtime.notes]
     return _with_range(doc, add.text, add, _channels_end(list(channels.values())), aid, notes)
 
 

@@ -12,6 +12,17 @@ list (rotation-first roots such as ``Zrotation Xrotation Yrotation Xposition …
 the joint in its parent's frame), as every common BVH reader does. ``world_j =
 world_parent · local_j``.
 
+Position conventions. Exporters disagree on what a position channel holds. **Relative**
+(the reading above, most mocap converters): the channel is added to the joint's OFFSET.
+**Absolute** (Blender's exporter, and what bvhio and Blender's importer assume): the channel
+*replaces* the OFFSET on its axis. :func:`detect_positions` picks one per file from the
+root's first frame (see there); :attr:`BvhClip.positions` holds it and every pose method
+uses it unless told otherwise. With a zero root OFFSET the two agree.
+
+Rows after the declared ``Frames:`` count (an exporter's extra row, QAvimator's appended key
+lists) are ignored; :attr:`BvhClip.warnings` names how many. Too few numbers, or a token that
+is not a number inside the declared frames, is still an error.
+
 Frame ``i`` plays at ``i · frame_time`` seconds. :attr:`BvhClip.channels` turns the motion
 into channels of the channel engine (one key per frame, linear spans, constant
 extrapolation); rotation channels hold **radians**, position channels file units, so they
@@ -23,6 +34,7 @@ Every malformed file raises :class:`~qtanimator.formats.FormatError` with its li
 
 from __future__ import annotations
 
+import logging
 import math
 import os
 import re
@@ -41,7 +53,16 @@ from qtanimator.formats.errors import FormatError
 
 FloatArray = npt.NDArray[np.float64]
 
-__all__ = ["BvhClip", "BvhJoint", "load_bvh", "parse_bvh", "summarize", "CHANNEL_NAMES"]
+__all__ = ["BvhClip", "BvhJoint", "CHANNEL_NAMES", "POSITION_CONVENTIONS", "detect_positions", "load_bvh",
+           "parse_bvh", "summarize"]
+
+log = logging.getLogger(__name__)
+
+#: How position channels combine with the OFFSET: added ("relative") or replacing it ("absolute").
+POSITION_CONVENTIONS = ("relative", "absolute")
+#: Below the root a joint's position channels must stay within this fraction of the
+#: skeleton's size of their first frame's value (qtanimator's 3D joints below the root only turn).
+STILL_TOLERANCE = 1e-4
 
 #: The six BVH channel names, in their canonical spelling.
 CHANNEL_NAMES = ("Xposition", "Yposition", "Zposition", "Xrotation", "Yrotation", "Zrotation")
@@ -86,8 +107,10 @@ class BvhClip:
     """A parsed BVH file: joints in file (depth-first) order and the motion table."""
 
     def __init__(self, joints: Sequence[BvhJoint], frame_time: float, motion: FloatArray,
-                 path: str | None = None) -> None:
+                 path: str | None = None, warnings: Sequence[str] = ()) -> None:
         self.path = path
+        #: Things the reader let pass, for the user (rows after the declared frames).
+        self.warnings: list[str] = list(warnings)
         self.joints: tuple[BvhJoint, ...] = tuple(joints)
         self.frame_time = float(frame_time)
         #: (frame_count, channel_count) values exactly as written: degrees and file units.
@@ -95,6 +118,8 @@ class BvhClip:
         self._channels: dict[str, Channel] | None = None
         self._radians: FloatArray | None = None
         self._kinds, self._axes, self._owner = _column_tables(self.joints)
+        #: The position convention every pose method uses: detected from the file.
+        self.positions: str = detect_positions(self)
 
     # ----------------------------------------------------------------- layout
     @property
@@ -198,10 +223,11 @@ class BvhClip:
         return values[i] * (1.0 - u) + values[i + 1] * u
 
     # ------------------------------------------------------------------- pose
-    def world_matrices(self, time: float | None = None, *, frame: int | None = None) -> FloatArray:
+    def world_matrices(self, time: float | None = None, *, frame: int | None = None,
+                       positions: str | None = None) -> FloatArray:
         """(J, 4, 4) world matrices at ``time`` seconds (channels interpolated linearly) or at
         motion row ``frame`` (the file's numbers, exactly). With neither, frame 0 (or the
-        rest pose for a file with no frames)."""
+        rest pose for a file with no frames). ``positions`` overrides :attr:`positions`."""
         if time is not None and frame is not None:
             raise ValueError("give a time or a frame, not both")
         if frame is not None:
@@ -213,16 +239,24 @@ class BvhClip:
         elif self.frame_count:
             row = self._row_radians(self.motion[0])
         else:
-            row = np.zeros(self.channel_count)
-        return self._world(row[None, :])[0]
+            return self.rest_world_matrices()
+        return self._world(row[None, :], positions)[0]
 
-    def all_world_matrices(self) -> FloatArray:
+    def all_world_matrices(self, positions: str | None = None) -> FloatArray:
         """(F, J, 4, 4) world matrices of every frame."""
-        return self._world(self.channel_values_radians())
+        return self._world(self.channel_values_radians(), positions)
+
+    def size(self) -> float:
+        """The skeleton's size: the largest extent of its rest pose (joints and End Sites),
+        1 for a skeleton with no extent."""
+        rest = self.rest_world_matrices()
+        points = [rest[:, :3, 3], *[p[None, :] for p in self.end_site_positions(rest).values()]]
+        extent = float(np.ptp(np.concatenate(points), axis=0).max()) if len(self.joints) else 0.0
+        return extent if extent > 0.0 else 1.0
 
     def rest_world_matrices(self) -> FloatArray:
         """(J, 4, 4) world matrices with every channel at 0 (offsets only)."""
-        return self._world(np.zeros((1, self.channel_count)))[0]
+        return self._world(np.zeros((1, self.channel_count)), "relative")[0]
 
     def end_site_positions(self, world: FloatArray) -> dict[int, FloatArray]:
         """World position of every End Site, keyed by its joint, from (J, 4, 4) matrices."""
@@ -238,8 +272,21 @@ class BvhClip:
         out[rot] = np.radians(out[rot])
         return out
 
-    def _world(self, values: FloatArray) -> FloatArray:
+    def local_translations(self, values: FloatArray, joint: int, positions: str | None = None) -> FloatArray:
+        """(F, 3) translation of ``joint`` in its parent's frame for rows of channel values:
+        the OFFSET plus (relative) or replaced by (absolute) its position channels."""
+        absolute = _convention(positions or self.positions) == "absolute"
+        j = self.joints[joint]
+        trans = np.broadcast_to(j.offset, (values.shape[0], 3)).copy()
+        for col in j.columns:
+            if self._kinds[col] == 0:
+                axis = int(self._axes[col])
+                trans[:, axis] = values[:, col] if absolute else trans[:, axis] + values[:, col]
+        return trans
+
+    def _world(self, values: FloatArray, positions: str | None = None) -> FloatArray:
         """World matrices for rows of channel values (radians): (F, C) -> (F, J, 4, 4)."""
+        absolute = _convention(positions or self.positions) == "absolute"
         frames = values.shape[0]
         nj = len(self.joints)
         world = np.empty((frames, nj, 4, 4))
@@ -252,7 +299,10 @@ class BvhClip:
                 axis = int(self._axes[col])
                 v = values[:, col]
                 if self._kinds[col] == 0:
-                    trans[:, axis] += v
+                    if absolute:
+                        trans[:, axis] = v
+                    else:
+                        trans[:, axis] += v
                 else:
                     rot = rot @ axis_rotations(axis, v)
             local[:, :3, :3] = rot
@@ -263,39 +313,62 @@ class BvhClip:
                 world[:, ji] = world[:, joint.parent] @ local
         return world
 
-    def to_skeleton(self) -> tuple[Skeleton, list[Channel | None]]:
+    def to_skeleton(self, positions: str | None = None) -> tuple[Skeleton, list[Channel | None]]:
         """A :class:`~qtanimator.core.skeleton.Skeleton` (one rotation order per joint) and
         channels in the ``.anim`` layout of :mod:`qtanimator.core.clip` (root translation
-        x, y, z, then x, y, z rotation per joint, radians) that pose it like this clip.
+        x, y, z, then x, y, z rotation per joint, radians) that pose it like this clip under
+        the position convention ``positions`` (default :attr:`positions`).
 
-        The root's position channels become the root translation; joints without a channel
-        get None. Raises ValueError for what a skeleton cannot hold: position channels
-        below the root, or several roots.
+        The root's position channels become the root translation (absolute: the root's
+        OFFSET is 0 on those axes, so the channel replaces it). A joint below the root whose
+        position channels stay still (within :data:`STILL_TOLERANCE` of the size; Blender
+        writes them equal to the OFFSET) gets that translation as its offset; joints without a
+        channel get None. Raises ValueError for what a skeleton cannot hold: a joint below
+        the root that moves, or several roots.
         """
+        convention = _convention(positions or self.positions)
         roots = [i for i, j in enumerate(self.joints) if j.parent is None]
         if len(roots) != 1:
             raise ValueError(f"a skeleton has one root; this BVH has {len(roots)}")
         joints: list[Joint] = []
         channels: list[Channel | None] = [None] * (3 + 3 * len(self.joints))
         by_name = self.channels
+        values = self.channel_values_radians() if self.frame_count else np.zeros((1, self.channel_count))
+        tolerance = STILL_TOLERANCE * self.size()
         for ji, j in enumerate(self.joints):
-            if ji != roots[0] and any(c.endswith("position") for c in j.channels):
-                raise ValueError(f"joint '{j.name}' has position channels; a skeleton moves only its root")
+            offset = j.offset.copy()
+            moves = any(c.endswith("position") for c in j.channels)
+            if ji == roots[0]:
+                if moves and convention == "absolute":
+                    for c in j.channels:
+                        if c.endswith("position"):
+                            offset["xyz".index(c[0].lower())] = 0.0
+            elif moves:
+                trans = self.local_translations(values, ji, convention)
+                drift = float(np.abs(trans - trans[0]).max())
+                if drift > tolerance:
+                    raise ValueError(f"joint '{j.name}' moves (its position channels change by up to {drift:.6g} "
+                                     "file units); qtanimator's 3D joints below the root only turn")
+                offset = trans[0].copy()
             order = j.rotation_order
             order += "".join(a for a in "xyz" if a not in order)
-            joints.append(Joint(j.name, j.parent, j.offset.copy(), rotation_order=order,
+            joints.append(Joint(j.name, j.parent, offset, rotation_order=order,
                                 boxmin=np.zeros(3), boxmax=np.zeros(3)))
             for c in j.channels:
                 axis = "xyz".index(c[0].lower())
-                index = axis if c.endswith("position") else 3 + 3 * ji + axis
-                channels[index] = by_name[f"{j.key}/{c}"]
+                if c.endswith("position"):
+                    if ji == roots[0]:
+                        channels[axis] = by_name[f"{j.key}/{c}"]
+                else:
+                    channels[3 + 3 * ji + axis] = by_name[f"{j.key}/{c}"]
         skeleton = Skeleton(joints, rotation_order="zyx", name=Path(self.path).stem if self.path else "")
         if self.frame_count:
             first = self.values_at(0.0)
             for col, (ji, c) in enumerate(self.channel_layout):
                 axis = "xyz".index(c[0].lower())
                 if c.endswith("position"):
-                    skeleton.root_translation[axis] = first[col]
+                    if ji == roots[0]:
+                        skeleton.root_translation[axis] = first[col]
                 else:
                     skeleton.set_dof(ji, axis, first[col])
         return skeleton, channels
@@ -314,7 +387,46 @@ class BvhClip:
             "fps": self.fps,
             "duration": self.duration,
             "rotation_orders": orders,
+            "positions": self.positions,
+            "warnings": list(self.warnings),
         }
+
+
+def _convention(name: str) -> str:
+    if name not in POSITION_CONVENTIONS:
+        raise ValueError(f"unknown BVH position convention {name!r}; expected 'relative' or 'absolute'")
+    return name
+
+
+def detect_positions(clip: BvhClip) -> str:
+    """The position convention of a file: ``"absolute"`` or ``"relative"``.
+
+    Both kinds of writer put the root's rest position in its OFFSET; an absolute file's first
+    frame repeats it, a relative file's first frame holds a displacement near zero. So the
+    file is absolute when the first frame's root position is within half the OFFSET's length
+    of the OFFSET: compared on the vertical (y) axis when the OFFSET lifts the root by more
+    than 5% of the skeleton's size (the horizontal start of a walk is arbitrary), else on all
+    position axes. An OFFSET shorter than 5% of the size (or a root without position
+    channels, or no frames) gives ``"relative"``: then the two conventions differ by less.
+    """
+    root = next((i for i, j in enumerate(clip.joints) if j.parent is None), None)
+    if root is None or not clip.frame_count:
+        return "relative"
+    joint = clip.joints[root]
+    cols = [c for c in joint.columns if clip._kinds[c] == 0]
+    if not cols:
+        return "relative"
+    axes = [int(clip._axes[c]) for c in cols]
+    offset = joint.offset[axes]
+    first = clip.motion[0, cols]
+    size = clip.size()
+    if 1 in axes and abs(float(joint.offset[1])) > 0.05 * size:
+        k = axes.index(1)
+        return "absolute" if abs(first[k] - offset[k]) <= 0.5 * abs(offset[k]) else "relative"
+    length = float(np.linalg.norm(offset))
+    if length <= 0.05 * size:
+        return "relative"
+    return "absolute" if float(np.linalg.norm(first - offset)) <= 0.5 * length else "relative"
 
 
 def _column_tables(joints: Sequence[BvhJoint]) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64],
@@ -417,8 +529,10 @@ class _Parser:
         frame_time = self.frame_time_header()
         built = self.build_joints(joints)
         ncols = sum(len(j.channels) for j in built)
-        motion = self.motion(frames, ncols, ftok)
-        return BvhClip(built, frame_time, motion, self.path)
+        motion, warnings = self.motion(frames, ncols, ftok)
+        for w in warnings:
+            log.warning("%s: %s", os.path.basename(self.path) if self.path else "BVH", w)
+        return BvhClip(built, frame_time, motion, self.path, warnings)
 
     def parse_joint(self, head: _Tok, parent: int | None, joints: list[dict[str, Any]]) -> None:
         """Parse ``ROOT|JOINT name { … }`` iteratively (no recursion limit on depth)."""
@@ -532,9 +646,11 @@ class _Parser:
             raise self.error(f"the frame time must be positive, found {ttok.text}.", ttok)
         return value
 
-    def motion(self, frames: int, ncols: int, ftok: _Tok) -> FloatArray:
+    def motion(self, frames: int, ncols: int, ftok: _Tok) -> tuple[FloatArray, list[str]]:
+        """The declared frames and the warnings (rows after them, which are ignored)."""
         rest = self.toks[self.pos:]
         expected = frames * ncols
+        warnings: list[str] = []
         if len(rest) < expected:
             got = len(rest)
             row, col = divmod(got, ncols) if ncols else (0, 0)
@@ -542,9 +658,22 @@ class _Parser:
                              f"{expected} numbers, found {got} (frame {row + 1} is missing value "
                              f"{col + 1}).")
         if len(rest) > expected:
-            extra = rest[expected]
-            raise self.error(f"more motion data than 'Frames: {frames}' × {ncols} channels; "
-                             f"unexpected '{_show(extra.text)}'.", extra)
+            # Extra rows: the declared frames must then be whole rows, one per line, so that a
+            # short row is never filled from the next one.
+            lines: list[list[_Tok]] = []
+            for t in rest:
+                if lines and lines[-1][0].line == t.line:
+                    lines[-1].append(t)
+                else:
+                    lines.append([t])
+            for i, row_toks in enumerate(lines[:frames]):
+                if len(row_toks) != ncols:
+                    raise self.error(f"frame {i + 1} has {len(row_toks)} numbers, but the hierarchy has "
+                                     f"{ncols} channels.", row_toks[min(len(row_toks), ncols) - 1])
+            extra = len(lines) - frames
+            warnings.append(f"{extra} row{'s' if extra != 1 else ''} after the declared {frames} frame"
+                            f"{'s' if frames != 1 else ''} {'were' if extra != 1 else 'was'} ignored.")
+            rest = rest[:expected]
         for t in rest:
             if not _NUMBER.fullmatch(t.text):
                 raise self.error(f"expected a number in the motion data, found '{_show(t.text)}'.", t)
@@ -552,7 +681,7 @@ class _Parser:
         if not np.isfinite(values).all():
             bad = rest[int(np.flatnonzero(~np.isfinite(values.reshape(-1)))[0])]
             raise self.error(f"motion value '{_show(bad.text)}' is too large.", bad)
-        return values
+        return values, warnings
 
 
 def _show(text: str, limit: int = 40) -> str:

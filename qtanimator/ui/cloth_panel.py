@@ -18,14 +18,12 @@ from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
-    QDoubleSpinBox,
     QFormLayout,
     QHBoxLayout,
     QLabel,
     QLineEdit,
     QPushButton,
     QScrollArea,
-    QSpinBox,
     QVBoxLayout,
     QWidget,
 )
@@ -34,23 +32,35 @@ from qtanimator.core.cloth import INTEGRATORS, PIN_MODES, ClothParams, Sphere
 from qtanimator.document.cloth import ASSET_KIND, add_cloth_command, cloth_params, set_cloth_param_command
 from qtanimator.document.document import DocumentChange
 from qtanimator.ui.context import EditorContext
+from qtanimator.ui.widgets import CheckedDoubleSpinBox, CheckedSpinBox
 
 _gestures = itertools.count(1)
 
-#: (minimum, maximum, step, decimals) of the float fields.
+#: (minimum, maximum, step, decimals) of the float fields. The minimums are the ones
+#: :meth:`ClothParams.validate` enforces (≥ 0, or > 0 for sizes and mass); where the model
+#: has no maximum the field's is far beyond any useful value, so a typed value is accepted
+#: rather than clamped (stiffness 1e7 is fine: the implicit integrator takes it). A typed
+#: value outside a field's range is refused with the reason shown, never clamped.
 FLOAT_RANGES: dict[str, tuple[float, float, float, int]] = {
-    "width": (0.01, 100.0, 0.1, 3), "height": (0.01, 100.0, 0.1, 3),
-    "total_mass": (0.001, 1000.0, 0.1, 3),
-    "structural_stiffness": (0.0, 1e6, 10.0, 2), "structural_damping": (0.0, 1e4, 0.05, 3),
-    "shear_stiffness": (0.0, 1e6, 10.0, 2), "shear_damping": (0.0, 1e4, 0.05, 3),
-    "bend_stiffness": (0.0, 1e6, 1.0, 2), "bend_damping": (0.0, 1e4, 0.01, 3),
-    "drag_coefficient": (0.0, 10.0, 0.05, 3), "air_density": (0.0, 2000.0, 0.05, 3),
-    "turbulence": (0.0, 100.0, 0.1, 3), "gravity": (-100.0, 100.0, 0.1, 3),
-    "ground_height": (-100.0, 100.0, 0.05, 3), "ground_restitution": (0.0, 1.0, 0.05, 3),
-    "ground_friction": (0.0, 1.0, 0.05, 3), "collision_margin": (0.0, 1.0, 0.001, 4),
+    "width": (0.001, 1e4, 0.1, 3), "height": (0.001, 1e4, 0.1, 3),
+    "total_mass": (0.001, 1e6, 0.1, 3),
+    "structural_stiffness": (0.0, 1e9, 10.0, 2), "structural_damping": (0.0, 1e6, 0.05, 3),
+    "shear_stiffness": (0.0, 1e9, 10.0, 2), "shear_damping": (0.0, 1e6, 0.05, 3),
+    "bend_stiffness": (0.0, 1e9, 1.0, 2), "bend_damping": (0.0, 1e6, 0.01, 3),
+    "drag_coefficient": (0.0, 1e3, 0.05, 3), "air_density": (0.0, 1e5, 0.05, 3),
+    "turbulence": (0.0, 1e4, 0.1, 3), "gravity": (-1e4, 1e4, 0.1, 3),
+    "ground_height": (-1e6, 1e6, 0.05, 3), "ground_restitution": (0.0, 1.0, 0.05, 3),
+    "ground_friction": (0.0, 100.0, 0.05, 3), "collision_margin": (0.0, 100.0, 0.001, 4),
 }
-INT_RANGES: dict[str, tuple[int, int]] = {"rows": (2, 200), "cols": (2, 200), "turbulence_seed": (0, 2**31 - 1),
-                                          "substeps": (1, 1000)}
+#: Why a field stops where the model does not (shown when a value beyond it is typed).
+RANGE_REASONS: dict[str, str] = {
+    "ground_restitution": "above 1 every bounce would gain energy",
+    "rows": "a bigger grid would take too long to simulate", "cols": "a bigger grid would take too long to simulate",
+}
+INT_RANGES: dict[str, tuple[int, int]] = {"rows": (2, 1000), "cols": (2, 1000), "turbulence_seed": (0, 2**31 - 1),
+                                          "substeps": (0, 100_000)}
+#: What an int field shows at its minimum when that value means something else.
+SPECIAL_MINIMUM: dict[str, str] = {"substeps": "auto"}
 CHOICES: dict[str, tuple[str, ...]] = {"pin_mode": PIN_MODES, "integrator": INTEGRATORS}
 VECTORS = ("wind", "origin", "orientation")
 GROUPS = (
@@ -108,6 +118,14 @@ class ClothPanel(QWidget):
         self.message.setObjectName("clothMessage")
         self.message.setWordWrap(True)
         outer.addWidget(self.message)
+        # Without numba the solver runs on numpy, several times slower: say so once, here.
+        from qtanimator.core import cloth_kernels
+
+        self.speed_note = QLabel(cloth_kernels.SLOW_PATH_NOTE or "", self)
+        self.speed_note.setObjectName("clothSpeedNote")
+        self.speed_note.setWordWrap(True)
+        self.speed_note.setVisible(bool(cloth_kernels.SLOW_PATH_NOTE))
+        outer.addWidget(self.speed_note)
         busy = QHBoxLayout()
         self.progress = QLabel(self)
         self.progress.setObjectName("clothProgress")
@@ -154,17 +172,24 @@ class ClothPanel(QWidget):
         self.live.blockSignals(False)
 
     # ------------------------------------------------------------- editors
-    def _spin(self, name: str, parent: QWidget, lo: float, hi: float, step: float, decimals: int) -> QDoubleSpinBox:
-        s = QDoubleSpinBox(parent)
+    def _spin(self, name: str, parent: QWidget, lo: float, hi: float, step: float,
+              decimals: int) -> CheckedDoubleSpinBox:
+        s = CheckedDoubleSpinBox(parent, label=_label(name))
         s.setRange(lo, hi)
         s.setSingleStep(step)
         s.setDecimals(decimals)
         s.setObjectName(f"cloth_{name}")
+        s.why_max = RANGE_REASONS.get(name, "")
         # A typed value is one edit, committed with Enter or on leaving the field (not one
         # command and one re-simulation per keystroke); the arrows still apply at once.
         s.setKeyboardTracking(False)
         s.editingFinished.connect(self.end_gesture)
+        s.refused.connect(self._refused)
         return s
+
+    def _refused(self, reason: str) -> None:
+        """A typed value outside a field's range: say why (the field is red too)."""
+        self.message.setText(reason)
 
     def _make_editor(self, name: str, parent: QWidget) -> QWidget:
         if name in FLOAT_RANGES:
@@ -173,9 +198,13 @@ class ClothPanel(QWidget):
             self.editors[name] = s
             return s
         if name in INT_RANGES:
-            i = QSpinBox(parent)
+            i = CheckedSpinBox(parent, label=_label(name))
+            i.refused.connect(self._refused)
+            i.why_max = RANGE_REASONS.get(name, "")
             i.setObjectName(f"cloth_{name}")
             i.setRange(*INT_RANGES[name])
+            if name in SPECIAL_MINIMUM:
+                i.setSpecialValueText(SPECIAL_MINIMUM[name])
             i.setKeyboardTracking(False)
             i.editingFinished.connect(self.end_gesture)
             i.valueChanged.connect(lambda v, n=name: self.edit(n, int(v)))
@@ -199,7 +228,7 @@ class ClothPanel(QWidget):
             row = QHBoxLayout(w)
             row.setContentsMargins(0, 0, 0, 0)
             spins = []
-            lim = 1000.0 if name != "orientation" else 2 * math.pi
+            lim = 1e6 if name != "orientation" else 2 * math.pi
             for axis in "xyz":
                 s = self._spin(f"{name}_{axis}", w, -lim, lim, 0.1, 3)
                 s.valueChanged.connect(lambda _v, n=name: self._vector_edited(n))
@@ -207,7 +236,7 @@ class ClothPanel(QWidget):
                 spins.append(s)
             self.editors[name] = spins
             if name == "wind":
-                speed = self._spin("wind_speed", w, 0.0, 1000.0, 0.5, 2)
+                speed = self._spin("wind_speed", w, 0.0, 1e6, 0.5, 2)
                 speed.setPrefix("speed ")
                 speed.valueChanged.connect(self._speed_edited)
                 row.addWidget(speed)
@@ -219,8 +248,8 @@ class ClothPanel(QWidget):
             row.setContentsMargins(0, 0, 0, 0)
             on = QCheckBox("on", w)
             on.setObjectName("cloth_sphere_on")
-            spins = [self._spin(f"sphere_{k}", w, -1000.0, 1000.0, 0.05, 3) for k in ("x", "y", "z", "radius")]
-            spins[3].setRange(0.001, 1000.0)
+            spins = [self._spin(f"sphere_{k}", w, -1e6, 1e6, 0.05, 3) for k in ("x", "y", "z", "radius")]
+            spins[3].setRange(0.001, 1e6)
             on.toggled.connect(lambda _v: self._sphere_edited())
             row.addWidget(on)
             for s in spins:

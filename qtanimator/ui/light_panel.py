@@ -11,7 +11,6 @@ from PySide6.QtCore import Qt
 from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
     QColorDialog,
-    QDoubleSpinBox,
     QFormLayout,
     QGroupBox,
     QHBoxLayout,
@@ -24,8 +23,14 @@ from qtanimator.document.commands import SetParameter
 from qtanimator.document.document import DocumentChange
 from qtanimator.render.gl.lights import AMBIENT_PARAMETER, LIGHT_NAMES, parameter
 from qtanimator.ui.context import EditorContext
+from qtanimator.ui.widgets import CheckedDoubleSpinBox
 
 _gestures = itertools.count(1)
+#: Field ranges. A light's intensity is any number ≥ 0 (above 1 it brightens past its
+#: colour, which is fine) and its position any place: the maximums are far beyond use.
+#: A typed value outside them is refused with the reason shown, never clamped.
+INTENSITY_LIMIT = 1000.0
+POSITION_LIMIT = 1e6
 
 
 def _to_qcolor(rgb: Any) -> QColor:
@@ -60,8 +65,8 @@ class LightPanel(QWidget):
         super().__init__(parent)
         self.setObjectName("lightPanel")
         self.ctx = ctx
-        self.position: dict[str, list[QDoubleSpinBox]] = {}
-        self.intensity: dict[str, QDoubleSpinBox] = {}
+        self.position: dict[str, list[CheckedDoubleSpinBox]] = {}
+        self.intensity: dict[str, CheckedDoubleSpinBox] = {}
         self.color: dict[str, ColorButton] = {}
         self._updating = False
         self._gesture: tuple[str, int] | None = None
@@ -72,9 +77,9 @@ class LightPanel(QWidget):
             row = QHBoxLayout()
             spins = []
             for axis in "xyz":
-                s = QDoubleSpinBox(box)
+                s = CheckedDoubleSpinBox(box, label=f"Light {i} position {axis}")
                 s.setObjectName(f"{name}_position_{axis}")
-                s.setRange(-1000.0, 1000.0)
+                s.setRange(-POSITION_LIMIT, POSITION_LIMIT)
                 s.setDecimals(2)
                 s.setSingleStep(0.1)
                 s.setKeyboardTracking(False)
@@ -86,11 +91,14 @@ class LightPanel(QWidget):
             form.addRow("Position", row)
             self.color[name] = ColorButton(self, f"{name}.color")
             form.addRow("Colour", self.color[name])
-            inten = QDoubleSpinBox(box)
+            inten = CheckedDoubleSpinBox(box, label=f"Light {i} intensity")
             inten.setObjectName(f"{name}_intensity")
-            inten.setRange(0.0, 10.0)
+            inten.setRange(0.0, INTENSITY_LIMIT)
             inten.setDecimals(2)
             inten.setSingleStep(0.05)
+            # A typed value is one edit on Enter: with a command per keystroke, the refresh
+            # after "1" rewrote the field to "1.00" under the typing and "1.5" became 1.0.
+            inten.setKeyboardTracking(False)
             inten.valueChanged.connect(lambda v, n=name: self._push(f"{n}.intensity", float(v)))
             inten.editingFinished.connect(self.end_gesture)
             self.intensity[name] = inten

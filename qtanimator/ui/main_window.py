@@ -37,6 +37,7 @@ from qtanimator.formats.errors import FormatError
 from qtanimator.paths import app_icon_path
 from qtanimator.ui import errors, help_viewer
 from qtanimator.ui.context import EditorContext
+from qtanimator.ui.widgets import install_dock_behaviour
 
 PROJECT_SUFFIX = ".qtanim"
 PROJECT_FILTER = "qtanimator projects (*.qtanim *.json)"
@@ -51,11 +52,25 @@ EDITOR_MODULES: list[str] = [
     "qtanimator.ui.joint_tree",
     "qtanimator.ui.properties",
     "qtanimator.ui.curve_editor",
+    "qtanimator.ui.dope_sheet",
     "qtanimator.ui.cloth_panel",
     "qtanimator.ui.light_panel",
     "qtanimator.ui.export_dialog",
     "qtanimator.ui.recovery",
 ]
+
+#: The view-state entry (``Document.view_state``) holding the current frame: saved with the
+#: project, restored on open, never an edit. (The play range is the project's
+#: ``frame_start`` / ``frame_end`` parameters, saved with every project.)
+FRAME_VIEW_STATE = "timeline.frame"
+
+
+def redo_shortcuts() -> list[QKeySequence]:
+    """Redo: the platform's keys (Ctrl+Shift+Z) and Ctrl+Y, each once."""
+    keys = QKeySequence.keyBindings(QKeySequence.StandardKey.Redo)
+    extra = QKeySequence("Ctrl+Y")
+    return keys + ([extra] if extra not in keys else [])
+
 
 #: Openers for files that are not projects, by lower-case suffix; editors register them.
 Opener = Callable[["MainWindow", Path], None]
@@ -87,7 +102,9 @@ class MainWindow(QMainWindow):
         self.openers: dict[str, Opener] = {}
         #: Called before the document is written (Save, Save As, autosave): editors put view
         #: state such as the 3D camera into the document here, without an undo step.
-        self.save_hooks: list[Callable[[], None]] = []
+        self.save_hooks: list[Callable[[], None]] = [self._store_frame]
+        # Fields ignore the wheel unless focused; Ctrl+Z undoes the document from any field.
+        install_dock_behaviour()
         self.setAcceptDrops(True)
         self.setDockNestingEnabled(True)
         self.resize(1400, 900)
@@ -173,7 +190,11 @@ class MainWindow(QMainWindow):
         self.action_undo.setShortcut(QKeySequence.StandardKey.Undo)
         self.action_redo = stack.createRedoAction(self, "&Redo")
         self.action_redo.setObjectName("actionRedo")
-        self.action_redo.setShortcuts([QKeySequence.StandardKey.Redo, QKeySequence("Ctrl+Y")])
+        self.action_redo.setShortcuts(redo_shortcuts())
+        # Undo and redo the document whatever has the focus: a dock field, a floating dock
+        # (DockBehaviour lets these keys past a text field that is not being edited).
+        for action in (self.action_undo, self.action_redo):
+            action.setShortcutContext(Qt.ShortcutContext.ApplicationShortcut)
         self.edit_menu.addAction(self.action_undo)
         self.edit_menu.addAction(self.action_redo)
         self.edit_menu.addSeparator()
@@ -277,6 +298,7 @@ class MainWindow(QMainWindow):
                 doc, relinks = open_document_relinked(p, self.locate_missing_file)
                 self._relinked_unsaved = bool(relinks)
                 self.ctx.replace_document(doc)
+                self.restore_view_state()
                 if relinks:
                     self._tell_relinked(relinks)
             else:
@@ -329,6 +351,17 @@ class MainWindow(QMainWindow):
             return "", False
         files = dialog.selectedFiles()
         return (files[0] if files else ""), box.isChecked()
+
+    def _store_frame(self) -> None:
+        """Save hook: the current frame goes into the view state (no undo step)."""
+        self.doc.set_view_state(FRAME_VIEW_STATE, float(self.ctx.frame))
+
+    def restore_view_state(self) -> None:
+        """After opening a project: go to the frame it was saved at (when it has one)."""
+        stored = self.doc.view_state.get(FRAME_VIEW_STATE)
+        if isinstance(stored, (int, float)) and not isinstance(stored, bool) and stored == stored \
+                and abs(stored) != float("inf"):
+            self.ctx.set_frame(float(stored))
 
     def prepare_save(self) -> None:
         """Let the editors store their view state in the document (see ``save_hooks``)."""
@@ -474,8 +507,8 @@ class MainWindow(QMainWindow):
 
     # --------------------------------------------------------------- layout
     def _default_layout(self) -> None:
-        """First-run arrangement: curve editor above the timeline along the bottom, the
-        joint tree on the left, properties / cloth / lights as tabs on the right."""
+        """First-run arrangement: curve editor (the dope sheet as a tab beside it) above the
+        timeline along the bottom, the joint tree on the left, properties / cloth / lights as tabs on the right."""
         def dock(name: str) -> QDockWidget | None:
             return self.findChild(QDockWidget, name)
 
@@ -485,6 +518,10 @@ class MainWindow(QMainWindow):
             self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, timeline)
             self.splitDockWidget(curve, timeline, Qt.Orientation.Vertical)
             self.resizeDocks([curve, timeline], [300, 130], Qt.Orientation.Vertical)
+            dope = dock("dopeSheetDock")
+            if dope is not None:  # both show keys: a tab beside the curve editor
+                self.tabifyDockWidget(curve, dope)
+                curve.raise_()
         right = [d for d in (dock("propertiesDock"), dock("clothDock"), dock("lightDock")) if d is not None]
         for other in right[1:]:
             self.tabifyDockWidget(right[0], other)

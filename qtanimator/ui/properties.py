@@ -9,12 +9,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import fields
+from dataclasses import fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from PySide6.QtCore import Qt
+from PySide6.QtCore import Qt, QTimer
 from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
@@ -23,7 +23,6 @@ from PySide6.QtWidgets import (
     QGroupBox,
     QLabel,
     QScrollArea,
-    QSpinBox,
     QVBoxLayout,
     QWidget,
 )
@@ -33,6 +32,7 @@ from qtanimator.document.commands import SetParameter
 from qtanimator.document.document import DocumentChange
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.joint_tree import c2d, c3d
+from qtanimator.ui.widgets import CheckedDoubleSpinBox, CheckedSpinBox
 
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
@@ -157,20 +157,31 @@ class PropertiesPanel(QWidget):
         return label
 
     def _parameter_editor(self, form: QFormLayout, title: str, path: str, default: Any,
-                          choices: list[str] | None = None, decimals: int = 4) -> QWidget:
-        """An editor for one document parameter; every change is a SetParameter."""
+                          choices: list[str] | None = None, decimals: int = 4,
+                          check: Callable[[Any], str | None] | None = None) -> QWidget:
+        """An editor for one document parameter; every change is a SetParameter.
+
+        ``check(value)`` gives the reason a value is refused (None: accepted): the
+        parameter's own definition decides (e.g. :class:`PendulumParams`); a refused value
+        leaves the document as it was and the field says why."""
         doc = self.ctx.doc
         name = "param_" + path.replace(".", "_")
+        widget: QWidget
 
         def current() -> Any:
             return doc.parameter(path, default)
 
         def push(value: Any) -> None:
+            reason = check(value) if check is not None else None
+            if reason is not None:
+                self.refresh()  # the field shows the document's value again...
+                if isinstance(widget, (CheckedSpinBox, CheckedDoubleSpinBox)):
+                    widget.refuse(f"{title}: {reason}")  # ...and why the typed one was refused
+                return
             if current() != value:
                 self.ctx.push(SetParameter(doc, path, value, text=f"Set {title}", gesture=("properties", path,
                                                                                            object())))
 
-        widget: QWidget
         if choices is not None:
             combo = QComboBox()
             combo.addItems(choices)
@@ -195,7 +206,7 @@ class PropertiesPanel(QWidget):
             self._refreshers.append(refresh_check)
             widget = box
         elif isinstance(default, int):
-            spin = QSpinBox()
+            spin = CheckedSpinBox(label=title)
             spin.setRange(0, 1_000_000)
             spin.setKeyboardTracking(False)
             spin.valueChanged.connect(lambda v: push(int(v)))
@@ -208,7 +219,7 @@ class PropertiesPanel(QWidget):
             self._refreshers.append(refresh_int)
             widget = spin
         else:
-            dspin = QDoubleSpinBox()
+            dspin = CheckedDoubleSpinBox(label=title)
             dspin.setDecimals(decimals if abs(float(default)) >= 1e-3 or default == 0 else 9)
             dspin.setRange(-1e9, 1e9)
             dspin.setKeyboardTracking(False)
@@ -334,7 +345,8 @@ class PropertiesPanel(QWidget):
             elif f.name == "integrator":
                 choices = list(INTEGRATORS)
             label, tip = PENDULUM_LABELS.get(f.name, (f.name, ""))
-            editor = self._parameter_editor(form, label, path, default, choices, decimals=6)
+            editor = self._parameter_editor(form, label, path, default, choices, decimals=6,
+                                            check=self._pendulum_check(asset, f.name))
             editor.setToolTip(f"{tip} (default {getattr(defaults, f.name)!r})" if tip else
                               f"default {getattr(defaults, f.name)!r}")
             # What is shown is the effective value (preset + overrides).
@@ -354,6 +366,21 @@ class PropertiesPanel(QWidget):
         self._refreshers.append(refresh_problem)
         form.addRow(problem)
         return group
+
+    def _pendulum_check(self, asset: str, name: str) -> Callable[[Any], str | None]:
+        """The pendulum parameters' own validation (``PendulumParams``) as a field check."""
+        m2 = c2d()
+        assert m2 is not None
+        doc = self.ctx.doc
+
+        def check(value: Any) -> str | None:
+            try:
+                replace(m2.pendulum_params(doc, asset), **{name: value})
+            except (TypeError, ValueError) as exc:
+                return str(exc)
+            return None
+
+        return check
 
     def _effective_refresher(self, editor: QWidget, asset: str, name: str) -> Callable[[], None]:
         m2 = c2d()
@@ -388,7 +415,41 @@ class PropertiesPanel(QWidget):
                 form.addRow(f"Limits {axis}", QLabel(_limits_text(float(dof.min), float(dof.max))))
         else:
             form.addRow("Joints", QLabel(str(len(names))))
+        self._bvh_positions_editor(form, asset)
         return group
+
+    def _bvh_positions_editor(self, form: QFormLayout, asset: str) -> None:
+        """A BVH character's position convention (issue 21): one undoable command per change."""
+        m3 = c3d()
+        doc = self.ctx.doc
+        current = m3.bvh_positions(doc, asset) if m3 is not None else None
+        if m3 is None or current is None:
+            return
+        combo = QComboBox()
+        combo.setObjectName("bvhPositions")
+        combo.addItems(["relative", "absolute"])
+        combo.setCurrentText(current)
+        combo.setToolTip("How the file's root positions combine with the root's OFFSET: added (relative, "
+                         "most mocap) or replacing it (absolute, Blender's exporter). Detected when the file "
+                         "was opened.")
+
+        def push(value: str) -> None:
+            if value == m3.bvh_positions(doc, asset):
+                return
+            try:
+                command = m3.set_bvh_positions_command(doc, asset, value)
+            except (OSError, ValueError) as exc:  # FormatError is a ValueError: the file is gone or changed
+                combo.blockSignals(True)
+                combo.setCurrentText(str(m3.bvh_positions(doc, asset)))
+                combo.blockSignals(False)
+                combo.setToolTip(f"Cannot switch: {exc}")
+                return
+            # The change rebuilds this panel, deleting the combo: push after its signal returns.
+            QTimer.singleShot(0, lambda: self.ctx.push(command))
+
+        combo.currentTextChanged.connect(push)
+        form.addRow("BVH positions", combo)
+        self.editors["bvh_positions"] = combo
 
     def _ik_group(self) -> QGroupBox:
         group = QGroupBox("IK solver")

@@ -250,6 +250,7 @@ class RecoveryManager(QObject):
             return False
         doc.path = record.original_path
         self.window.ctx.replace_document(doc)
+        self.window.restore_view_state()
         # The recovered work is not saved anywhere the user chose: keep it marked modified.
         self.window.ctx.undo_stack.resetClean()
         self.window.setWindowModified(True)

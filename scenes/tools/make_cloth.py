@@ -23,6 +23,7 @@ ROWS, COLS = 16, 24
 
 def flag_params() -> ClothParams:
     return ClothParams(
+        integrator="symplectic",
         rows=ROWS, cols=COLS, width=1.6, height=1.0, total_mass=1.0,
         structural_stiffness=200.0, structural_damping=0.2,
         shear_stiffness=80.0, shear_damping=0.1,

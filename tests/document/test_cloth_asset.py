@@ -18,7 +18,7 @@ from qtanimator.document.cloth import (
     set_cloth_param_command,
 )
 
-SMALL = ClothParams(rows=8, cols=8, wind=(0.0, 0.0, 2.0))
+SMALL = ClothParams(rows=8, cols=8, wind=(0.0, 0.0, 2.0), integrator="symplectic")
 
 
 def make_doc(params: ClothParams = SMALL) -> tuple[Document, UndoStack, str]:

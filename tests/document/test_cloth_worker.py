@@ -18,7 +18,7 @@ from qtanimator.document.document import DocumentChange
 #: A flag like the demo's: wind, gusts (turbulence), custom pins, ground.
 FLAG = ClothParams(rows=8, cols=10, width=1.2, height=0.8, total_mass=1.0, wind=(6.0, 0.0, 0.8),
                    turbulence=0.5, turbulence_seed=3, pin_mode="custom", custom_pins=[0, 10, 20, 30],
-                   substeps=16, origin=(0.0, 1.5, 0.0))
+                   substeps=16, origin=(0.0, 1.5, 0.0), integrator="symplectic")
 DT = 1.0 / 60.0
 
 

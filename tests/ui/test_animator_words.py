@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from pathlib import Path
 
 from PySide6.QtWidgets import QFormLayout, QGroupBox, QLabel, QWidget
@@ -39,8 +40,9 @@ def test_the_curve_editor_opens_normalised_and_frames_the_selected_joint(make_wi
     window = make_window(editors=("rig_editor", "timeline", "curve_editor"))
     assert window.open_path(DEMO)
     view = window.curve_editor.view
-    # Pip's x position spans hundreds of units, the joints' angles about a radian.
-    assert view.normalised
+    # Pip's x position spans hundreds of units and the joints' angles tens of degrees (shown
+    # in degrees): comparable, so the editor opens in raw values.
+    assert not view.normalised
     view.set_normalised(False)  # in raw values, framing all would span the positions' hundreds
     view.frame_all()
     window.ctx.select("pip", "forearm_left")
@@ -53,4 +55,4 @@ def test_the_curve_editor_opens_normalised_and_frames_the_selected_joint(make_wi
     assert x0 <= times.min() and times.max() <= x1
     # Framed on the joint: its curve fills a good part of the view, not a sliver of it.
     assert (values.max() - values.min()) > 0.3 * (y1 - y0)
-    assert y1 - y0 < 20.0
+    assert y1 - y0 < 20.0 * 180.0 / math.pi   # degrees

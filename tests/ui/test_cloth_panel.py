@@ -39,8 +39,9 @@ def test_edits_change_the_cloth_and_undo(qtbot):
     for v in (300.0, 350.0, 400.0):
         stiff.setValue(v)
     assert cloth_params(doc, "cloth").structural_stiffness == 400.0
-    w.findChild(QComboBox, "cloth_integrator").setCurrentText("implicit")
-    assert cloth_params(doc, "cloth").integrator == "implicit"
+    other = "symplectic" if ClothParams().integrator == "implicit" else "implicit"  # not the default
+    w.findChild(QComboBox, "cloth_integrator").setCurrentText(other)
+    assert cloth_params(doc, "cloth").integrator == other
     w.findChild(QDoubleSpinBox, "cloth_wind_x").setValue(2.0)
     assert cloth_params(doc, "cloth").wind == (2.0, 0.0, 0.0)
     w.findChild(QDoubleSpinBox, "cloth_wind_speed").setValue(5.0)
@@ -170,3 +171,16 @@ def test_long_cloth_work_shows_progress_and_can_be_cancelled(qtbot, monkeypatch)
     assert worker.wait(60)
     qtbot.waitUntil(lambda: not label.isVisible() and not button.isVisible(), timeout=5000)
     w.ctx.undo_stack.setClean()
+
+
+@pytest.mark.parametrize("note", [None, "Cloth runs on the numpy fallback: slower."])
+def test_the_dock_says_when_the_cloth_runs_without_the_compiled_solver(qtbot, monkeypatch, note):
+    from qtanimator.core import cloth_kernels
+
+    monkeypatch.setattr(cloth_kernels, "SLOW_PATH_NOTE", note)
+    w = _window(qtbot)
+    w.show()
+    label = w.findChild(QLabel, "clothSpeedNote")
+    assert label is not None
+    assert label.isVisibleTo(w) == (note is not None)
+    assert label.text() == (note or "")

@@ -16,10 +16,12 @@ FPS = 60.0
 
 
 def make_doc() -> Document:
+    """Values in the document's units everywhere (no rotation: those show in degrees; see
+    test_curve_editor_animator.py)."""
     doc = Document()
     doc.channels["hero//x"] = Channel([Key(0.0, 0.0), Key(0.5, 2.0), Key(1.0, 1.0, "flat", "flat")],
                                       post="cycle")
-    doc.channels["hero/arm/angle"] = Channel(
+    doc.channels["hero/arm/bend"] = Channel(
         [Key.make(0.25, -1.0, "linear", "linear"), Key.make(1.25, 1.5, 0.0, 3.0)], pre="linear", post="bounce")
     doc.channels["hero//y"] = Channel([Key(0.1, 0.5), Key(0.6, -0.5), Key(0.9, 0.2)],
                                       pre="cycle_offset", post="cycle_offset")
@@ -205,7 +207,7 @@ def test_click_shift_click_and_box_select(qtbot, editor):
     drag(qtbot, ed, view_pos(ed, -5, 0.7), view_pos(ed, 40, -0.8))
     assert ed.view.selected_keys() == {"hero//x": [0], "hero//y": [0, 1]}
     drag(qtbot, ed, view_pos(ed, 70, 1.7), view_pos(ed, 80, 1.3), mods=Qt.KeyboardModifier.ShiftModifier)
-    assert ed.view.selected_keys() == {"hero//x": [0], "hero//y": [0, 1], "hero/arm/angle": [1]}
+    assert ed.view.selected_keys() == {"hero//x": [0], "hero//y": [0, 1], "hero/arm/bend": [1]}
     qtbot.mouseClick(vp, Qt.MouseButton.LeftButton, pos=view_pos(ed, 85, -1.3))
     assert ed.view.selected_keys() == {}
 
@@ -310,8 +312,8 @@ def test_current_frame_line_follows_and_scrubs(qtbot, editor):
     ed.ctx.set_frame(25.0)
     assert ed.view.frame_line.value() == 25.0
     vp = ed.plot.viewport()
-    start = view_pos(ed, 25, 2.2)
-    drag(qtbot, ed, start, view_pos(ed, 61.3, 2.2))
+    start = viewport_pos(ed, ed.view.frame_line.handle_scene_pos())  # the playhead's handle
+    drag(qtbot, ed, start, QPoint(view_pos(ed, 61.3, 2.2).x(), start.y()))
     assert ed.ctx.frame == 61.0
     assert ed.ctx.doc.state() == make_doc().state()
     assert vp is not None
@@ -361,21 +363,21 @@ def test_wheel_with_ctrl_zooms_time_only(qtbot, editor):
 def test_tree_filter_visibility_and_selection_sync(qtbot, editor):
     ed = editor
     tree = ed.tree
-    assert ed.view.visible == ["hero//x", "hero/arm/angle", "hero//y"]
+    assert ed.view.visible == ["hero//x", "hero/arm/bend", "hero//y"]
     tree.search.setText("arm")
-    assert ed.view.visible == ["hero/arm/angle"]
+    assert ed.view.visible == ["hero/arm/bend"]
     tree.search.setText("")
     tree.set_checked(["hero//y"], False)
-    assert ed.view.visible == ["hero//x", "hero/arm/angle"]
+    assert ed.view.visible == ["hero//x", "hero/arm/bend"]
     assert tree._groups[("hero", "")].checkState() == Qt.CheckState.PartiallyChecked
     tree._groups[("hero", "")].setCheckState(Qt.CheckState.Unchecked)
     assert ed.view.visible == []
     tree._groups[("hero", "")].setCheckState(Qt.CheckState.Checked)
-    assert ed.view.visible == ["hero//x", "hero/arm/angle", "hero//y"]
+    assert ed.view.visible == ["hero//x", "hero/arm/bend", "hero//y"]
     # Another editor selects a joint: the tree row is selected and its channels highlighted.
     ed.ctx.select("hero", "arm")
-    assert tree.selected_channels() == ["hero/arm/angle"]
-    assert ed.view.highlighted == {"hero/arm/angle"}
+    assert tree.selected_channels() == ["hero/arm/bend"]
+    assert ed.view.highlighted == {"hero/arm/bend"}
     # Clicking a DOF row selects its joint and channel in the context.
     leaf = tree.proxy.mapFromSource(tree._leaves["hero//y"].index())
     rect = tree.view.visualRect(leaf)
@@ -388,11 +390,11 @@ def test_tree_filter_visibility_and_selection_sync(qtbot, editor):
     ed.action_only_selected.trigger()
     assert ed.view.visible == ["hero//x"]
     ed.ctx.select("hero", "arm")
-    assert ed.view.visible == ["hero/arm/angle"]
+    assert ed.view.visible == ["hero/arm/bend"]
     ed.ctx.select("hero", "")
-    assert ed.view.visible == ["hero//x", "hero/arm/angle", "hero//y"]  # the asset: all of its channels
+    assert ed.view.visible == ["hero//x", "hero/arm/bend", "hero//y"]  # the asset: all of its channels
     ed.action_only_selected.trigger()
-    assert ed.view.visible == ["hero//x", "hero/arm/angle", "hero//y"]
+    assert ed.view.visible == ["hero//x", "hero/arm/bend", "hero//y"]
 
 
 def test_only_the_edited_channel_is_rebuilt(qtbot, editor):
@@ -401,12 +403,12 @@ def test_only_the_edited_channel_is_rebuilt(qtbot, editor):
     ed = editor
     ed.plot.grab()
     builds = {cid: ed.view.drawing(cid).builds for cid in ed.view.visible}
-    ed.ctx.push(InsertKey(ed.ctx.doc, "hero/arm/angle", Key(0.5, 0.0)))
+    ed.ctx.push(InsertKey(ed.ctx.doc, "hero/arm/bend", Key(0.5, 0.0)))
     ed.plot.grab()
     after = {cid: ed.view.drawing(cid).builds for cid in ed.view.visible}
-    assert after["hero/arm/angle"] > builds["hero/arm/angle"]
-    assert {c: n for c, n in after.items() if c != "hero/arm/angle"} == \
-        {c: n for c, n in builds.items() if c != "hero/arm/angle"}
+    assert after["hero/arm/bend"] > builds["hero/arm/bend"]
+    assert {c: n for c, n in after.items() if c != "hero/arm/bend"} == \
+        {c: n for c, n in builds.items() if c != "hero/arm/bend"}
     ed.view.refresh_all()  # a redraw with nothing changed builds nothing
     ed.plot.grab()
     assert {cid: ed.view.drawing(cid).builds for cid in ed.view.visible} == after
@@ -469,7 +471,7 @@ def test_new_channels_appear_and_reset_rebuilds(qtbot, editor):
     from qtanimator.document import InsertKey
 
     ed = editor
-    ed.ctx.push(InsertKey(ed.ctx.doc, "wasp/knee_01_l/rz", Key(0.2, 0.3)))
+    ed.ctx.push(InsertKey(ed.ctx.doc, "wasp/knee_01_l/rz", Key(0.2, 0.01)))  # 0.57°: in view
     assert "wasp/knee_01_l/rz" in ed.tree.channel_ids()
     assert "wasp/knee_01_l/rz" in ed.view.visible
     qtbot.mouseClick(ed.plot.viewport(), Qt.MouseButton.LeftButton, pos=key_pos(ed, "wasp/knee_01_l/rz", 0))

@@ -3,6 +3,8 @@ drag frame that redraws only the dragged channel (issues #12 and #17)."""
 
 from __future__ import annotations
 
+import math
+
 import pytest
 from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
@@ -15,6 +17,7 @@ from qtanimator.ui.context import EditorContext
 from qtanimator.ui.curve_editor import CurveEditor
 
 FPS = 60.0
+DEG = 180.0 / math.pi
 DRAGGED = "hero/arm/rz"
 
 
@@ -35,7 +38,8 @@ def editor(qtbot):
     qtbot.addWidget(ed)
     ed.show()
     qtbot.waitExposed(ed)
-    ed.view.vb.setRange(xRange=(-10, 90), yRange=(-1.0, 1.0), padding=0)
+    # Rotations are shown in degrees: the view spans ±1 radian.
+    ed.view.vb.setRange(xRange=(-10, 90), yRange=(-DEG, DEG), padding=0)
     QApplication.processEvents()
     return ed
 
@@ -45,7 +49,8 @@ def key_pos(ed: CurveEditor, cid: str, i: int) -> QPoint:
 
 
 def view_pos(ed: CurveEditor, frame: float, value: float) -> QPoint:
-    return ed.plot.mapFromScene(ed.view.vb.mapViewToScene(QPointF(frame, value)))
+    """Where (frame, value in radians) is drawn: the channels are rotations, shown in degrees."""
+    return ed.plot.mapFromScene(ed.view.vb.mapViewToScene(QPointF(frame, value * DEG)))
 
 
 def move(qtbot, ed: CurveEditor, pos: QPoint) -> None:

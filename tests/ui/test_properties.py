@@ -98,3 +98,24 @@ def test_ik_solver_settings_drive_the_right_drag(make_window, qtbot, shared_data
     moved = c2d.evaluate_pose(window.doc, asset, 0.0).to_world(2, local)
     target = view.to_scene(QPointF(start + QPoint(-60, 10)))
     assert np.hypot(*(moved - target)) < np.hypot(*(start_xy - target))
+
+
+def test_a_pendulum_value_the_simulation_cannot_take_is_refused_with_its_reason(qtbot, clock):
+    window, panel = clock
+    doc = window.doc
+    window.ctx.select("clock", "")
+    step = panel.findChild(QDoubleSpinBox, "param_clock_pendulum_step")
+    before = c2d.pendulum_params(doc, "clock").step
+    qtbot.mouseClick(step, Qt.MouseButton.LeftButton)
+    qtbot.keyClick(step, Qt.Key.Key_A, Qt.KeyboardModifier.ControlModifier)
+    qtbot.keyClicks(step, "0")
+    qtbot.keyClick(step, Qt.Key.Key_Return)
+    assert c2d.pendulum_params(doc, "clock").step == before     # PendulumParams refuses a zero step
+    assert step.value() == pytest.approx(before, abs=1e-6)   # shown to 6 decimals
+    assert "at least" in step.toolTip() and "at least" in window.statusBar().currentMessage()
+    assert window.ctx.undo_stack.count() == 0
+    qtbot.keyClick(step, Qt.Key.Key_A, Qt.KeyboardModifier.ControlModifier)
+    qtbot.keyClicks(step, "0.001")
+    qtbot.keyClick(step, Qt.Key.Key_Return)
+    assert c2d.pendulum_params(doc, "clock").step == pytest.approx(0.001)
+    assert window.ctx.undo_stack.count() == 1

@@ -42,7 +42,7 @@ def test_a_cloth_blow_up_is_marked_on_the_cache_bar_and_in_the_status_bar(make_w
     from qtanimator.document.cloth import add_cloth_command
 
     window = make_window(full=True)
-    params = ClothParams(rows=8, cols=8, structural_stiffness=1.0e4, substeps=1)
+    params = ClothParams(rows=8, cols=8, structural_stiffness=1.0e4, substeps=1, integrator="symplectic")
     window.ctx.push(add_cloth_command(window.doc, params))
     window.central_tabs.setCurrentWidget(window.viewport3d.parentWidget() or window.viewport3d)
     window.ctx.set_frame(60.0)  # the 3D view asks for the cloth's frames: the worker blows up

@@ -1,24 +1,27 @@
 """Numeric fields for the active key: frame, value, in slope and out slope.
 
-Slopes are shown in value per second (the channel's unit, as ``.anim`` files store them).
-Editing a slope makes that side fixed; unless the key is broken, the other side follows,
-as when dragging a handle. Each edit is one command.
+Values are shown in the channel's display unit (degrees for rotations, as the plot shows
+them) and slopes in that unit per second. Editing a slope makes that side fixed; unless
+the key is broken, the other side follows, as when dragging a handle. Each edit is one
+command. With no key selected the fields are empty and disabled.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from PySide6.QtWidgets import QDoubleSpinBox, QHBoxLayout, QLabel, QWidget
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QWidget
 
 from qtanimator.core.channel import Tangent
 from qtanimator.document.commands import EditKey
 from qtanimator.document.curve_commands import SetKeySlopes
+from qtanimator.ui.curves.normalisation import unit_suffix
 from qtanimator.ui.curves.view import CurveView
+from qtanimator.ui.widgets import CheckedDoubleSpinBox
 
 
-def _spin(name: str, decimals: int, tip: str) -> QDoubleSpinBox:
-    box = QDoubleSpinBox()
+def _spin(name: str, decimals: int, tip: str) -> CheckedDoubleSpinBox:
+    box = CheckedDoubleSpinBox(label=name.removeprefix("curveKey").replace("Slope", " slope"))
     box.setObjectName(name)
     box.setRange(-1e9, 1e9)
     box.setDecimals(decimals)
@@ -64,6 +67,10 @@ class KeyFields(QWidget):
             return None
         return cid, i, ch
 
+    def unit(self, cid: str) -> float:
+        """Shown value per document value (degrees for rotations)."""
+        return self.view.unit(cid)
+
     def load(self) -> None:
         found = self._active()
         boxes = (self.frame, self.value, self.in_slope, self.out_slope)
@@ -71,18 +78,24 @@ class KeyFields(QWidget):
             box.setEnabled(found is not None)
         if found is None:
             self.label.setText("No key selected")
+            for box in boxes:
+                box.clear()  # empty: nothing to show (the value is kept, unused)
             return
         cid, i, ch = found
         key = ch.keys[i]
         s_in, s_out = ch.slopes()
         count = sum(len(s) for s in self.view.selection.values())
         self.label.setText(f"{cid} [{i}]" + (f" (+{count - 1})" if count > 1 else ""))
+        unit, suffix = self.unit(cid), unit_suffix(cid)
         self._loading = True
         try:
+            self.value.setSuffix(suffix)
+            self.in_slope.setSuffix(f"{suffix}/s" if suffix else "")
+            self.out_slope.setSuffix(f"{suffix}/s" if suffix else "")
             self.frame.setValue(key.time * self.view.fps)
-            self.value.setValue(key.value)
-            self.in_slope.setValue(float(s_in[i]))
-            self.out_slope.setValue(float(s_out[i]))
+            self.value.setValue(key.value * unit)
+            self.in_slope.setValue(float(s_in[i]) * unit)
+            self.out_slope.setValue(float(s_out[i]) * unit)
         finally:
             self._loading = False
 
@@ -98,7 +111,8 @@ class KeyFields(QWidget):
         try:
             cmd = EditKey(self.view.doc, cid, i, key.moved(t, key.value), text="Key Time")
         except ValueError:
-            self.load()  # another key is at that time
+            self.load()  # another key is at that time: refused, and the field says why
+            self.frame.refuse(f"Another key of {cid} is at frame {frame:g}.")
             return
         self.view.push(cmd)
         j = self.view.doc.channels[cid].key_index(t)
@@ -111,7 +125,8 @@ class KeyFields(QWidget):
             return
         cid, i, ch = found
         key = ch.keys[i]
-        if value != key.value:
+        value = value / self.unit(cid)
+        if not _same(value, key.value, self.value.decimals(), self.unit(cid)):
             self.view.push(EditKey(self.view.doc, cid, i, key.moved(key.time, value), text="Key Value"))
 
     def _slope_edited(self, side: str, slope: float) -> None:
@@ -120,6 +135,7 @@ class KeyFields(QWidget):
             return
         cid, i, ch = found
         key = ch.keys[i]
+        slope = slope / self.unit(cid)
         if key.broken:
             ins, outs = (slope, None) if side == "in" else (None, slope)
         else:
@@ -129,3 +145,9 @@ class KeyFields(QWidget):
             return
         self.view.push(SetKeySlopes(self.view.doc, cid, i, ins, outs, text="Key Slope"))
 
+
+
+def _same(value: float, current: float, decimals: int, unit: float) -> bool:
+    """True when ``value`` (from a field showing ``decimals`` decimals of ``unit``·value)
+    is the document's ``current`` as the field shows it: no edit."""
+    return round(value * unit, decimals) == round(current * unit, decimals)

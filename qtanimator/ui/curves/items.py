@@ -92,14 +92,39 @@ def map_points(tr: QTransform, x: FloatArray, y: FloatArray) -> tuple[FloatArray
     return px, py
 
 
-def handle_offsets(tr: QTransform, slope: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Pixel offsets of an out handle of length HANDLE_LENGTH for slopes ``slope`` (in the
-    units ``tr`` maps: y per x). The in handle is the negated offset of its own slope."""
+def handle_offsets(tr: QTransform, slope: FloatArray,
+                   extent: FloatArray | None = None) -> tuple[FloatArray, FloatArray]:
+    """Pixel offsets of an out handle for slopes ``slope`` (in the units ``tr`` maps: y per
+    x): HANDLE_LENGTH pixels long, or, where ``extent`` (x units) is finite, the real handle
+    of a weighted key, ``extent`` along x. The in handle is the negated offset of its own
+    slope and extent."""
     dx = tr.m11() + tr.m21() * slope
     dy = tr.m12() + tr.m22() * slope
     norm = np.hypot(dx, dy)
     norm[norm == 0] = 1.0
-    return HANDLE_LENGTH * dx / norm, HANDLE_LENGTH * dy / norm
+    ox, oy = HANDLE_LENGTH * dx / norm, HANDLE_LENGTH * dy / norm
+    if extent is not None:
+        real = np.isfinite(extent)
+        if real.any():
+            e = np.where(real, extent, 0.0)
+            ox = np.where(real, dx * e, ox)
+            oy = np.where(real, dy * e, oy)
+    return ox, oy
+
+
+def handle_extents(channel: Channel) -> tuple[FloatArray, FloatArray] | None:
+    """Per key, the time extents (seconds) of the in and out handles drawn at their real
+    length — the sides of weighted spans, as evaluation uses them — and NaN for handles
+    drawn at the fixed length; None when the channel has no weighted span."""
+    if not channel.is_weighted:
+        return None
+    weighted, h_out, h_in = channel.span_handles()
+    n = len(channel.keys)
+    ins = np.full(n, np.nan)
+    outs = np.full(n, np.nan)
+    outs[:-1] = np.where(weighted, h_out, np.nan)
+    ins[1:] = np.where(weighted, h_in, np.nan)
+    return ins, outs
 
 
 def display_transform(offset: float, scale: float) -> QTransform:
@@ -360,8 +385,10 @@ def _paint_keys(p: QPainter, tr: QTransform, d: ChannelDrawing, x0: float, x1: f
         sx, sy = sx[keep], sy[keep]
     else:
         s_in, s_out = d.channel.slopes()
-        ox, oy = handle_offsets(tr, s_out[sel] / d.fps)
-        ix, iy = handle_offsets(tr, s_in[sel] / d.fps)
+        ext = handle_extents(d.channel)
+        e_in, e_out = (None, None) if ext is None else (ext[0][sel] * d.fps, ext[1][sel] * d.fps)
+        ox, oy = handle_offsets(tr, s_out[sel] / d.fps, e_out)
+        ix, iy = handle_offsets(tr, s_in[sel] / d.fps, e_in)
         n = len(sel)
         types = np.tile(np.array([MOVE_TO, LINE_TO, LINE_TO], np.int32), n)
         hx = np.column_stack([sx - ix, sx, sx + ox]).ravel()
@@ -383,6 +410,7 @@ class HoverMark:
     selected: bool = False
     slope: float = 0.0   # display slope (display value per frame) of the hovered handle
     side: str = ""       # "in" or "out" for a handle
+    extent: float = math.nan  # frames along time of a real-length (weighted) handle
 
 
 class HoverLayer(pg.GraphicsObject):
@@ -418,7 +446,7 @@ class HoverLayer(pg.GraphicsObject):
             big = KEY_SIZE + 4
             p.drawRect(QRectF(px[0] - big / 2, py[0] - big / 2, big, big))
         else:
-            ox, oy = handle_offsets(tr, np.array([m.slope]))
+            ox, oy = handle_offsets(tr, np.array([m.slope]), np.array([m.extent]))
             sign = 1.0 if m.side == "out" else -1.0
             p.setBrush(QColor(255, 225, 140))
             p.drawEllipse(QPointF(px[0] + sign * ox[0], py[0] + sign * oy[0]), HANDLE_SIZE / 2 + 2,

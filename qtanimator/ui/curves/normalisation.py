@@ -48,3 +48,25 @@ def channel_normalisation(channel: Channel) -> tuple[float, float]:
     if half <= 1e-12 * max(1.0, abs(mid)):
         return mid, 1.0
     return mid, 1.0 / half
+
+
+# ------------------------------------------------------------------ display units
+#: DOFs whose channels hold angles in radians (2D joint angles, 3D joint rotations). The
+#: curve editor shows them in degrees, like the DOF sliders and the properties dock.
+ROTATION_DOFS = frozenset({"angle", "rx", "ry", "rz"})
+DEGREES = 180.0 / np.pi
+
+
+def is_rotation(cid: str) -> bool:
+    """True for a channel that holds an angle in radians."""
+    return cid.rsplit("/", 1)[-1] in ROTATION_DOFS
+
+
+def unit_scale(cid: str) -> float:
+    """Displayed value per document value: 180/π for rotations (degrees), else 1."""
+    return DEGREES if is_rotation(cid) else 1.0
+
+
+def unit_suffix(cid: str) -> str:
+    """The unit the curve editor shows a channel's values in ("°" or "")."""
+    return "°" if is_rotation(cid) else ""

@@ -7,6 +7,11 @@ points are evenly spaced, so x is linear in the Bézier parameter. So a channel 
 from one path built once per channel object (:func:`bezier_path`) that the plot's
 transform maps to pixels; Qt flattens each cubic to the pixels it covers.
 
+A weighted span (a key with handle lengths, see :class:`~qtanimator.core.channel.Key`) is
+a cubic Bézier in time and value already: its control points are drawn as they are
+(``Channel.span_handles`` gives their extents along time, clamped as evaluation clamps
+them), so the path is exact for it too.
+
 When keys are denser than the pixels (a long clip zoomed out), :func:`reduced_path` draws
 a polyline through a subset of points on the curve instead: one per column of a few
 pixels where the curve is straight to within half a pixel, up to three (adding the
@@ -90,6 +95,10 @@ class Spans:
 
     ``v0`` / ``v1`` are the Hermite tangents ``Δt·out[i]`` / ``Δt·in[i+1]`` of each span;
     ``bend`` bounds ``|y''(u)|`` over a cubic span (0 for lines and steps).
+    ``weighted`` marks the Bézier spans of a channel with handle lengths (None when it has
+    none); ``c1`` / ``c2`` are then every span's inner control points as offsets from its
+    first / last key, in frames and values: ``(Δf/3, v0/3)`` and ``(−Δf/3, −v1/3)`` for a
+    Hermite span.
     """
 
     frames: FloatArray
@@ -98,6 +107,11 @@ class Spans:
     v0: FloatArray
     v1: FloatArray
     bend: FloatArray
+    weighted: npt.NDArray[np.bool_] | None = None
+    c1x: FloatArray | None = None
+    c1y: FloatArray | None = None
+    c2x: FloatArray | None = None
+    c2y: FloatArray | None = None
 
     @classmethod
     def of(cls, channel: Channel, fps: float) -> Spans:
@@ -111,11 +125,28 @@ class Spans:
         dt = np.diff(times)
         v0, v1 = dt * s_out[:-1], dt * s_in[1:]
         p0, p1 = values[:-1], values[1:]
+        if channel.is_weighted:
+            return cls._weighted(channel, fps, frames, values, kinds, v0, v1, s_in, s_out)
         # y''(u) = 6A·u + 2B over u in [0, 1] is largest at an end of the span.
         big_a = 2 * p0 - 2 * p1 + v0 + v1
         big_b = -3 * p0 + 3 * p1 - 2 * v0 - v1
         bend = np.where(kinds == _KIND_CUBIC, np.maximum(np.abs(2 * big_b), np.abs(6 * big_a + 2 * big_b)), 0.0)
         return cls(frames, values, kinds, v0, v1, bend)
+
+    @classmethod
+    def _weighted(cls, channel: Channel, fps: float, frames: FloatArray, values: FloatArray,
+                  kinds: npt.NDArray[np.int8], v0: FloatArray, v1: FloatArray, s_in: FloatArray,
+                  s_out: FloatArray) -> Spans:
+        weighted, h_out, h_in = channel.span_handles()
+        weighted = weighted & (kinds == _KIND_CUBIC)
+        p0, p1 = values[:-1], values[1:]
+        c1x, c1y = h_out * fps, h_out * s_out[:-1]
+        c2x, c2y = -h_in * fps, -h_in * s_in[1:]
+        # y''(u) of a Bézier is largest at an end: 6·(P2 − 2·P1 + P0) and 6·(P3 − 2·P2 + P1).
+        q1, q2 = p0 + c1y, p1 + c2y
+        bend = np.where(kinds == _KIND_CUBIC,
+                        6.0 * np.maximum(np.abs(q2 - 2 * q1 + p0), np.abs(p1 - 2 * q2 + q1)), 0.0)
+        return cls(frames, values, kinds, v0, v1, bend, weighted, c1x, c1y, c2x, c2y)
 
 
 def bezier_elements(channel: Channel, fps: float,
@@ -150,11 +181,18 @@ def bezier_elements(channel: Channel, fps: float,
     if cub.size:
         i = start[cub]
         types[i], types[i + 1], types[i + 2] = CURVE_TO, CURVE_DATA, CURVE_DATA
-        third = (f1[cub] - f0[cub]) / 3.0
-        x[i] = f0[cub] + third
-        y[i] = p0[cub] + sp.v0[cub] / 3.0   # p0 + m0·Δt/3
-        x[i + 1] = f1[cub] - third
-        y[i + 1] = p1[cub] - sp.v1[cub] / 3.0  # p1 − m1·Δt/3
+        if sp.weighted is None:
+            third = (f1[cub] - f0[cub]) / 3.0
+            x[i] = f0[cub] + third
+            y[i] = p0[cub] + sp.v0[cub] / 3.0   # p0 + m0·Δt/3
+            x[i + 1] = f1[cub] - third
+            y[i + 1] = p1[cub] - sp.v1[cub] / 3.0  # p1 − m1·Δt/3
+        else:
+            assert sp.c1x is not None and sp.c1y is not None and sp.c2x is not None and sp.c2y is not None
+            x[i] = f0[cub] + sp.c1x[cub]
+            y[i] = p0[cub] + sp.c1y[cub]
+            x[i + 1] = f1[cub] + sp.c2x[cub]
+            y[i + 1] = p1[cub] + sp.c2y[cub]
     con = np.flatnonzero(kinds == _KIND_CONSTANT)
     if con.size:
         i = start[con]
@@ -206,6 +244,17 @@ def span_samples(channel: Channel, fps: float, column: float, tolerance: float,
     lin = kinds[span] == _KIND_LINEAR   # only their keys (u = 0): the Hermite form is off
     y[lin] = p0[lin]
     x = frames[:-1][span] + u * width[span]
+    if sp.weighted is not None and sp.weighted.any():
+        # Bézier spans: x is not linear in the parameter; both coordinates in Bernstein form.
+        assert sp.c1x is not None and sp.c1y is not None and sp.c2x is not None and sp.c2y is not None
+        bez = np.flatnonzero(sp.weighted[span])
+        sb, ub = span[bez], u[bez]
+        vb = 1.0 - ub
+        w0, w1, w2, w3 = vb * vb * vb, 3.0 * vb * vb * ub, 3.0 * vb * ub * ub, ub * ub * ub
+        f0, f1 = frames[:-1][sb], frames[1:][sb]
+        q0, q3 = values[:-1][sb], values[1:][sb]
+        x[bez] = w0 * f0 + w1 * (f0 + sp.c1x[sb]) + w2 * (f1 + sp.c2x[sb]) + w3 * f1
+        y[bez] = w0 * q0 + w1 * (q0 + sp.c1y[sb]) + w2 * (q3 + sp.c2y[sb]) + w3 * q3
     return np.append(x, frames[-1]), np.append(y, values[-1])
 
 

@@ -10,18 +10,30 @@ the keys end where they started), and Escape aborts it, putting the document bac
 Mouse: left click selects a key (Shift adds / toggles), left drag on a key moves the
 selected keys (hold Shift once moving to lock to the main axis), Ctrl+drag on a key
 scales the selected keys in time about the current frame, drag on a handle sets a fixed
-slope, on empty space box-selects; Ctrl+click inserts a key on the curve under the
-cursor; middle drag or Alt+left drag pans; right drag zooms each axis; the wheel zooms
-(Ctrl: time only, Shift: values only); dragging the current-frame line scrubs.
+slope (and, on a weighted key, the handle's length), on empty space box-selects;
+Ctrl+click inserts a key on the curve under the cursor; right click selects the key or
+curve under the cursor (a key already selected keeps the selection) and opens the menu;
+middle drag or Alt+left drag pans; right drag zooms each axis; the wheel zooms (Ctrl:
+time only, Shift: values only). The playhead moves by its handle (the triangle at the top)
+or by a click or drag on the time axis; a key on the playhead drags like any other.
 Keys: A frame all, F frame selected, N normalise, Delete removes selected keys, Ctrl+A
 selects all keys, Escape aborts a drag.
+
+Units: rotations (``angle``, ``rx``, ``ry``, ``rz``; radians in the document) are shown in
+degrees, other channels in their own units (see :mod:`~.normalisation`); the display
+transform of a channel carries the unit, so picking, drags and handles all work in what
+is shown.
+
+The key selection is shared with the other editors through ``ctx.key_selection``: the
+view publishes its selection (source: the view) and takes the selection another editor
+sets, for the channels it shows.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -31,7 +43,7 @@ from PySide6.QtGui import QColor, QKeyEvent, QMouseEvent, QPen, QTransform
 from PySide6.QtWidgets import QGraphicsItem, QGraphicsRectItem, QWidget
 
 from qtanimator.core.channel import Channel, Key
-from qtanimator.document.commands import Command, DeleteKeys, InsertKey, MoveKeys
+from qtanimator.document.commands import Command, DeleteKeys, InsertKey, MoveKeys, SetChannels
 from qtanimator.document.curve_commands import SetKeySlopes
 from qtanimator.document.document import DocumentChange, split_channel_id
 from qtanimator.document.gesture import Gesture
@@ -43,11 +55,13 @@ from qtanimator.ui.curves.items import (
     HoverLayer,
     HoverMark,
     channel_colour,
+    handle_extents,
     handle_offsets,
     map_points,
 )
-from qtanimator.ui.curves.normalisation import NormalisationCache
+from qtanimator.ui.curves.normalisation import NormalisationCache, unit_scale
 
+PLAYHEAD_HANDLE = 14.0  # pixels: the playhead's handle at the top of the plot
 PICK_RADIUS = 7.0       # pixels: how close a click must be to a key or handle
 CURVE_PICK_RADIUS = 8.0  # pixels: how close to a curve Ctrl+click must be
 MOVE_HISTORY = 4096      # (before, after) pairs of dragged keys remembered per channel
@@ -68,26 +82,43 @@ class _Drag:
 
 
 class FrameLine(pg.InfiniteLine):
-    """The current-frame line. It lets keys and handles under it take the mouse."""
+    """The current-frame line (the playhead). Only its handle, the triangle at the top of
+    the plot, drags it (and the time axis scrubs): a key or a handle on the line takes
+    the mouse like any other, and clicks on the line go to what is under it."""
 
     def __init__(self, view: CurveView, **kw: Any) -> None:
         super().__init__(**kw)
         self._view = view
+        self.addMarker("v", position=1.0, size=PLAYHEAD_HANDLE)
 
-    def _covers_key(self, scene: QPointF) -> bool:
-        return self._view.handle_at(scene) is not None or self._view.key_at(scene) is not None
+    def handle_scene_pos(self) -> QPointF:
+        """Scene position of the middle of the handle."""
+        vb = self._view.vb
+        x = vb.mapViewToScene(QPointF(self.value(), 0.0)).x()
+        return QPointF(x, vb.sceneBoundingRect().top() + PLAYHEAD_HANDLE / 4.0)
+
+    def at_handle(self, scene: QPointF) -> bool:
+        """True when ``scene`` is on the handle (a little larger than drawn)."""
+        top = self._view.vb.sceneBoundingRect().top()
+        x = self._view.vb.mapViewToScene(QPointF(self.value(), 0.0)).x()
+        reach = PLAYHEAD_HANDLE / 2.0 + 3.0
+        return abs(scene.x() - x) <= reach and top - 3.0 <= scene.y() <= top + PLAYHEAD_HANDLE / 2.0 + 4.0
+
+    def hoverEvent(self, ev: Any) -> None:
+        if not ev.isExit() and self.movable and self.at_handle(ev.scenePos()) \
+                and ev.acceptDrags(Qt.MouseButton.LeftButton):
+            self.setMouseHover(True)
+        else:
+            self.setMouseHover(False)
 
     def mouseDragEvent(self, ev: Any) -> None:
-        if ev.isStart() and self._covers_key(ev.buttonDownScenePos()):
+        if ev.isStart() and not self.at_handle(ev.buttonDownScenePos()):
             ev.ignore()
             return
         super().mouseDragEvent(ev)
 
     def mouseClickEvent(self, ev: Any) -> None:
-        if self._covers_key(ev.scenePos()):
-            ev.ignore()
-            return
-        super().mouseClickEvent(ev)
+        ev.ignore()  # a click on the line is a click on the plot (select, deselect, menu)
 
 
 class CurveViewBox(pg.ViewBox):
@@ -109,6 +140,7 @@ class CurveViewBox(pg.ViewBox):
             self._view.click(ev.scenePos(), ev.modifiers())
         elif ev.button() == Qt.MouseButton.RightButton:
             ev.accept()
+            self._view.select_under(ev.scenePos())  # the menu acts on what was clicked
             self._view.context_menu_requested.emit(ev.screenPos())
         else:
             super().mouseClickEvent(ev)
@@ -215,6 +247,9 @@ class CurveView(QObject):
         #: What the mouse is over: ("key", cid, index), ("handle", cid, index, side) or None.
         self.hover: tuple[Any, ...] | None = None
         self._scrubbing = False
+        self._units: dict[str, float] = {}
+        #: True while the view takes a selection another editor set (not published back).
+        self._adopting = False
 
         self.widget = CurvePlot(self)
         self.plot_item = self.widget.getPlotItem()
@@ -256,6 +291,10 @@ class CurveView(QObject):
 
         ctx.frameChanged.connect(self._frame_changed)
         ctx.documentChanged.connect(self._document_changed)
+        self.keySelectionChanged.connect(self._publish_selection)
+        shared = getattr(ctx, "key_selection", None)
+        if shared is not None:
+            shared.changed.connect(self._shared_selection_changed)
         self.vb.sigRangeChanged.connect(lambda *_: self.refresh_all())
         self.vb.sigResized.connect(lambda *_: self.refresh_all())
         start, end = ctx.doc.frame_range
@@ -277,6 +316,7 @@ class CurveView(QObject):
         for cid in set(self._drawings) - set(wanted):
             del self._drawings[cid]
         self._prune_selection()
+        self._adopt_shared()  # keys another editor selected on channels now shown
         self.refresh_all()
 
     def set_highlighted(self, cids: Iterable[str]) -> None:
@@ -301,8 +341,15 @@ class CurveView(QObject):
         if frozen is not None:
             return frozen
         if not self.normalised:
-            return 0.0, 1.0
+            return 0.0, self.unit(cid)
         return self.norm.get(cid, self.doc.channels[cid])
+
+    def unit(self, cid: str) -> float:
+        """Displayed value per document value (180/π for rotations: degrees)."""
+        u = self._units.get(cid)
+        if u is None:
+            u = self._units[cid] = unit_scale(cid)
+        return u
 
     def refresh_channel(self, cid: str, update: bool = True) -> None:
         """Show the document's current version of one channel; only its layer is redrawn,
@@ -478,7 +525,7 @@ class CurveView(QObject):
     def hover_mark(self) -> HoverMark | None:
         """The key or handle under the mouse as the hover layer draws it (or None)."""
         h = self.hover
-        if h is None:
+        if h is None or h[0] == "playhead":
             return None
         cid, i = h[1], h[2]
         ch = self.doc.channels.get(cid)
@@ -491,7 +538,9 @@ class CurveView(QObject):
             return HoverMark("key", x, y, channel_colour(cid), selected=i in self.selection.get(cid, ()))
         s_in, s_out = ch.slopes()
         slope = float((s_out if h[3] == "out" else s_in)[i]) * scale / self.fps
-        return HoverMark("handle", x, y, channel_colour(cid), True, slope, h[3])
+        ext = handle_extents(ch)
+        extent = math.nan if ext is None else float(ext[1 if h[3] == "out" else 0][i]) * self.fps
+        return HoverMark("handle", x, y, channel_colour(cid), True, slope, h[3], extent)
 
     def view_to_scene(self) -> QTransform:
         self.vb.updateMatrix()  # pyqtgraph defers it to the next paint after a range change
@@ -541,8 +590,11 @@ class CurveView(QObject):
         x = np.array([ch.keys[index].time * self.fps])
         y = np.array([(ch.keys[index].value - off) * scale])
         px, py = map_points(tr, x, y)
-        ox, oy = handle_offsets(tr, np.array([s_out[index] * k]))
-        ix, iy = handle_offsets(tr, np.array([s_in[index] * k]))
+        ext = handle_extents(ch)
+        e_in, e_out = (None, None) if ext is None else (ext[0][index:index + 1] * self.fps,
+                                                       ext[1][index:index + 1] * self.fps)
+        ox, oy = handle_offsets(tr, np.array([s_out[index] * k]), e_out)
+        ix, iy = handle_offsets(tr, np.array([s_in[index] * k]), e_in)
         key = QPointF(px[0], py[0])
         return key, QPointF(px[0] - ix[0], py[0] - iy[0]), QPointF(px[0] + ox[0], py[0] + oy[0])
 
@@ -603,6 +655,64 @@ class CurveView(QObject):
 
     def select_all(self) -> None:
         self.set_selection({cid: range(len(self.doc.channels[cid].keys)) for cid in self.visible})
+
+    def select_under(self, scene: QPointF) -> None:
+        """Right click: select what is under the cursor, so that the menu acts on it. A key
+        that is selected already keeps the selection (it becomes the active key); another
+        key becomes the selection; a curve away from keys is selected as a channel (its
+        keys are deselected); empty space and handles keep the selection."""
+        if self.handle_at(scene) is not None:
+            return
+        hit = self.key_at(scene)
+        if hit is not None:
+            cid, i = hit
+            if i in self.selection.get(cid, ()):
+                if self.active != hit:
+                    self.active = hit
+                    self.keySelectionChanged.emit()
+            else:
+                self.set_selection({cid: [i]}, hit)
+            return
+        curve = self.curve_at(scene)
+        if curve is not None:
+            asset, joint, _dof = split_channel_id(curve)
+            self.ctx.select(asset, joint)
+            self.ctx.select_channels([curve])
+            self.clear_selection()
+
+    # ------------------------------------------------------- shared selection
+    def _publish_selection(self) -> None:
+        """Our selection changed: share it (``ctx.key_selection``). Keys another editor
+        selected on channels this view does not show stay selected there."""
+        shared = getattr(self.ctx, "key_selection", None)
+        if shared is None or self._adopting:
+            return
+        channels = self.doc.channels
+        shown = set(self.visible)
+        keys: dict[str, Iterable[int]] = {cid: idx for cid, idx in shared.valid(channels).items()
+                                          if cid not in shown}
+        keys.update({cid: idx for cid, idx in self.selection.items() if idx})
+        shared.set(keys, channels, self)
+
+    def _shared_selection_changed(self, source: object) -> None:
+        """Another editor (the dope sheet) selected keys: select those we show."""
+        if source is self or source is None:
+            return
+        self._adopt_shared()
+
+    def _adopt_shared(self) -> None:
+        shared = getattr(self.ctx, "key_selection", None)
+        if shared is None or self._drag is not None:
+            return
+        shown = set(self.visible)
+        wanted = {cid: set(idx) for cid, idx in shared.valid(self.doc.channels).items() if cid in shown}
+        if wanted == {c: s for c, s in self.selection.items() if s}:
+            return
+        self._adopting = True
+        try:
+            self.set_selection(wanted)
+        finally:
+            self._adopting = False
 
     # ------------------------------------------------------------- editing
     def push(self, command: Command) -> None:
@@ -706,9 +816,12 @@ class CurveView(QObject):
     # ---------------------------------------------------------------- hover
     def hover_at(self, scene: QPointF | None) -> None:
         """Highlight the key or handle under the mouse and show a cursor that says what a
-        drag will do there: move (keys), point (handles), arrow elsewhere."""
+        drag will do there: move (keys), point (handles), move sideways (the playhead's
+        handle, which takes the drag there), arrow elsewhere."""
         hit: tuple[Any, ...] | None = None
-        if scene is not None and not self.dragging and self.vb.sceneBoundingRect().contains(scene):
+        if scene is not None and not self.dragging and self.frame_line.at_handle(scene):
+            hit = ("playhead", "", -1)
+        elif scene is not None and not self.dragging and self.vb.sceneBoundingRect().contains(scene):
             handle = self.handle_at(scene)
             if handle is not None:
                 hit = ("handle", *handle)
@@ -719,8 +832,8 @@ class CurveView(QObject):
         if hit == self.hover:
             return
         self.hover = hit
-        shape = {None: None, "key": Qt.CursorShape.SizeAllCursor, "handle": Qt.CursorShape.PointingHandCursor}[
-            hit[0] if hit else None]
+        shape = {None: None, "key": Qt.CursorShape.SizeAllCursor, "handle": Qt.CursorShape.PointingHandCursor,
+                 "playhead": Qt.CursorShape.SizeHorCursor}[hit[0] if hit else None]
         viewport = self.widget.viewport()
         if shape is None:
             viewport.unsetCursor()
@@ -921,7 +1034,17 @@ class CurveView(QObject):
             ins, outs = (slope, None) if drag.side == "in" else (None, slope)
         else:
             ins, outs = slope, slope
-        self._preview(drag, SetKeySlopes(self.doc, cid, i, ins, outs, base=base))
+        weight = key.in_weight if drag.side == "in" else key.out_weight
+        ext = handle_extents(base)
+        real = ext is not None and math.isfinite(float(ext[0 if drag.side == "in" else 1][i]))
+        if weight is not None and real:
+            # A weighted key's handle: the drag sets its slope and its length (this side only).
+            edited = SetKeySlopes(self.doc, cid, i, ins, outs, base=base).changes[cid][1]
+            assert edited is not None
+            new_key = replace(edited.keys[i], **{f"{drag.side}_weight": abs(dx) / self.fps})
+            self._preview(drag, SetChannels("Tangent Handle", {cid: (base, base.replace_keys({i: new_key}))}))
+        else:
+            self._preview(drag, SetKeySlopes(self.doc, cid, i, ins, outs, base=base))
         self._update_live()
         self.keySelectionChanged.emit()
 
