@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 import numpy.typing as npt
-from PySide6.QtCore import QElapsedTimer, QPointF, QRectF, QSize, Qt, QTimer, Signal
+from PySide6.QtCore import QElapsedTimer, QLineF, QPointF, QRectF, QSize, Qt, QTimer, Signal
 from PySide6.QtGui import (
     QAction,
     QBrush,
@@ -85,7 +85,7 @@ def key_frames(ctx: EditorContext, asset: str | None = None, cache: FrameCache |
         if hit is not None and hit[0] is ch and hit[1] == fps:
             frames = hit[2]
         else:
-            frames = np.round(ch.times * fps, 6)
+            frames = _interned(np.round(ch.times * fps, 6))
             if cache is not None:
                 cache[cid] = (ch, fps, frames)
         arrays.append(frames)
@@ -94,7 +94,27 @@ def key_frames(ctx: EditorContext, asset: str | None = None, cache: FrameCache |
             del cache[cid]
     if not arrays:
         return []
-    return [float(f) for f in np.unique(np.concatenate(arrays))]
+    # Channels keyed on the same frames (every channel of a mocap clip) share one interned
+    # array: merge each distinct array once, not 96 copies of it.
+    distinct = list({id(a): a for a in arrays}.values())
+    return np.unique(np.concatenate(distinct)).tolist()
+
+
+#: Key-frame arrays by content, so that channels keyed on the same frames share one array.
+_FRAME_ARRAYS: dict[tuple[int, bytes], FloatArray] = {}
+_FRAME_ARRAYS_MAX = 4096
+
+
+def _interned(frames: FloatArray) -> FloatArray:
+    key = (len(frames), frames.tobytes())
+    hit = _FRAME_ARRAYS.get(key)
+    if hit is not None:
+        return hit
+    if len(_FRAME_ARRAYS) >= _FRAME_ARRAYS_MAX:
+        _FRAME_ARRAYS.clear()
+    frames.setflags(write=False)
+    _FRAME_ARRAYS[key] = frames
+    return frames
 
 
 class TimelineWidget(QWidget):
@@ -150,6 +170,17 @@ class TimelineWidget(QWidget):
             asset = self.ctx.selection[0]
             self._selected_keys = key_frames(self.ctx, asset, self._frame_cache) if asset else []
         return self._selected_keys
+
+    def _tick_lines(self, frames: list[float], top: float, bottom: float) -> list[QLineF]:
+        """Vertical lines at the pixel columns of ``frames`` inside the frame range."""
+        if not frames:
+            return []
+        first, last = self._span()
+        f = np.asarray(frames, dtype=np.float64)
+        f = f[(f >= first) & (f <= last)]
+        width = max(self.width() - 2 * MARGIN, 1)
+        xs = np.unique(np.round(MARGIN + (f - first) / (last - first) * width, 1))
+        return [QLineF(x, top, x, bottom) for x in xs.tolist()]
 
     # ---------------------------------------------------------- geometry
     def _span(self) -> tuple[int, int]:
@@ -215,17 +246,12 @@ class TimelineWidget(QWidget):
                 p.setPen(QPen(QColor(90, 90, 96), 1))
             f += minor
 
-        # Key ticks: every key in red, the selected character's keys taller.
+        # Key ticks: every key in red, the selected character's keys taller. One line per
+        # pixel column, drawn in one call (a mocap clip has a key on every frame).
         p.setPen(QPen(QColor(200, 30, 30), 1))
-        for kf in self.keys():
-            if first <= kf <= last:
-                x = self.frame_to_x(kf)
-                p.drawLine(QPointF(x, bar.top() + 10), QPointF(x, bar.bottom()))
+        p.drawLines(self._tick_lines(self.keys(), bar.top() + 10, bar.bottom()))
         p.setPen(QPen(QColor(255, 140, 0), 2))
-        for kf in self.selected_keys():
-            if first <= kf <= last:
-                x = self.frame_to_x(kf)
-                p.drawLine(QPointF(x, bar.top() + 4), QPointF(x, bar.bottom()))
+        p.drawLines(self._tick_lines(self.selected_keys(), bar.top() + 4, bar.bottom()))
 
         x = self.frame_to_x(self.ctx.frame)
         p.setPen(QPen(QColor(230, 0, 0), 2))

@@ -935,6 +935,13 @@ class CurveView(QObject):
         channels as they were when the drag began), folded into the drag's one step."""
         assert drag.gesture is not None
         drag.gesture.update(command)
+        # The editor doing the gesture redraws its own preview now; the other views (and
+        # this one again, at no cost: the channel object is the same) hear of the change at
+        # the next tick of the frame clock, which would add up to a frame to every move.
+        changes = getattr(command, "changes", None)
+        if isinstance(changes, dict):
+            for cid in changes:
+                self.refresh_channel(cid)
 
     def _drag_keys(self, drag: _Drag, scene: QPointF, mods: Qt.KeyboardModifier) -> None:
         start = self.vb.mapSceneToView(drag.start_scene)
