@@ -17,15 +17,15 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+import bvhio  # a test dependency: missing is an error, not a skip
 import numpy as np
 import pytest
+from samples import BLENDER_BVH
 
-bvhio = pytest.importorskip("bvhio")
-
-from qtanimator.core.clip import apply_clip  # noqa: E402
-from qtanimator.document.character3d import load_bvh_character  # noqa: E402
-from qtanimator.formats import FormatError  # noqa: E402
-from qtanimator.formats.bvh import detect_positions, load_bvh, parse_bvh  # noqa: E402
+from qtanimator.core.clip import apply_clip
+from qtanimator.document.character3d import load_bvh_character
+from qtanimator.formats import FormatError
+from qtanimator.formats.bvh import detect_positions, load_bvh, parse_bvh
 
 DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "bvh"
 SAMPLES = sorted(DATA.glob("*.bvh")) if DATA.is_dir() else []
@@ -245,27 +245,7 @@ def test_walking_feet_stay_on_the_floor_in_both_conventions(convention: str, tmp
 
 
 # ---------------------------------------------------------------- still broken
-TINY = """HIERARCHY
-ROOT Hips
-{
-  OFFSET 0 10 0
-  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
-  JOINT Leg
-  {
-    OFFSET 0 -5 0
-    CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
-    End Site
-    {
-      OFFSET 0 -5 0
-    }
-  }
-}
-MOTION
-Frames: 2
-Frame Time: 0.1
-0 10 0 0 0 0 0 -5 0 10 0 0
-1 10 0 0 0 0 0 -5 0 20 0 0
-"""
+TINY = BLENDER_BVH
 
 
 def test_tiny_blender_style_file() -> None:

@@ -9,12 +9,11 @@ import base64
 
 import numpy as np
 import pytest
+import resvg_py  # a test dependency: missing is an error, not a skip
 from PySide6.QtGui import QColor, QImage, QPainter
 
 from qtanimator.formats.svg_rig import parse_character
 from qtanimator.render.painter2d import draw_character, image_to_array
-
-resvg_py = pytest.importorskip("resvg_py")
 
 SIZE = 120
 HEAD = (f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" '

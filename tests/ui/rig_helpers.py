@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication
@@ -33,3 +35,25 @@ def hand_point(window, view) -> QPoint:  # type: ignore[no-untyped-def]
         if pick(doc, window.ctx.time, view.to_scene(QPointF(pixel))) == ("pip", j):
             return pixel
     raise AssertionError("the hand is covered everywhere")
+
+
+#: The bundled demo project.
+DEMO = Path(__file__).resolve().parents[2] / "scenes" / "demo" / "demo.qtanim"
+#: The editors the demo tests of the 2D animator install.
+DEMO_EDITORS = ("rig_editor", "timeline", "joint_tree", "properties")
+
+
+def open_demo(make_window, qtbot, focus: bool = False):  # type: ignore[no-untyped-def]
+    """A shown main window with the demo open in the 2D tab, the view fitted; with
+    ``focus`` the rig editor has the keyboard focus. Returns ``(window, view)``."""
+    window = make_window(editors=DEMO_EDITORS)
+    assert window.open_path(DEMO)
+    window.central_tabs.setCurrentWidget(window.rig_editor)
+    view = window.rig_editor.view
+    view.fit_view()
+    if focus:
+        view.setFocus()
+        qtbot.waitUntil(view.hasFocus)
+    else:
+        qtbot.wait(10)
+    return window, view

@@ -5,20 +5,17 @@ same channels whatever the IK settings."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from PySide6.QtCore import QEvent, QPoint, Qt
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QToolButton, QWidget
-from rig_helpers import hand_point, send_mouse
+from rig_helpers import DEMO, hand_point, open_demo, send_mouse
 
 from qtanimator.document import character2d as c2d
 from qtanimator.document import pose
 from qtanimator.document.commands import SetParameter
 
-DEMO = Path(__file__).resolve().parents[2] / "scenes" / "demo" / "demo.qtanim"
 FRAME = 37.0  # no channel of the demo has a key here
 
 #: Every keyframed joint of Pip and its position (what Shift+S keys).
@@ -32,13 +29,7 @@ PIP_ALL = {
 
 @pytest.fixture
 def demo(make_window, qtbot):
-    window = make_window(editors=("rig_editor", "timeline", "joint_tree", "properties"))
-    assert window.open_path(DEMO)
-    window.central_tabs.setCurrentWidget(window.rig_editor)
-    view = window.rig_editor.view
-    view.fit_view()
-    view.setFocus()
-    qtbot.waitUntil(view.hasFocus)
+    window, view = open_demo(make_window, qtbot, focus=True)
     window.ctx.set_frame(FRAME)
     return window, view
 

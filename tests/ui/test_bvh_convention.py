@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from PySide6.QtWidgets import QComboBox
+from samples import BLENDER_BVH
 
 from qtanimator.document.character3d import BVH_POSITIONS, world_matrices
 from qtanimator.ui.main_window import MainWindow
@@ -15,27 +16,7 @@ def private_settings(tmp_path_factory, monkeypatch):
     monkeypatch.setenv("QTANIMATOR_SETTINGS_DIR", str(tmp_path_factory.mktemp("settings")))
 
 # Blender-style: 6 channels per joint, the root's first position equal to its OFFSET.
-ABSOLUTE = """HIERARCHY
-ROOT Hips
-{
-  OFFSET 0 10 0
-  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
-  JOINT Leg
-  {
-    OFFSET 0 -5 0
-    CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation
-    End Site
-    {
-      OFFSET 0 -5 0
-    }
-  }
-}
-MOTION
-Frames: 2
-Frame Time: 0.1
-0 10 0 0 0 0 0 -5 0 10 0 0
-1 10 0 0 0 0 0 -5 0 20 0 0
-"""
+ABSOLUTE = BLENDER_BVH
 
 
 def test_switching_the_convention_is_one_undo_step_and_moves_the_character(qtbot, tmp_path, dialog_log):

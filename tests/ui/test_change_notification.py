@@ -4,11 +4,10 @@ end to end in the real main window (the demo project, real mouse events)."""
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import pytest
 from PySide6.QtCore import QEvent, QPoint, Qt
-from rig_helpers import hand_point, send_mouse
+from rig_helpers import hand_point, open_demo, send_mouse
 
 from qtanimator.core.channel import Key
 from qtanimator.document import character2d as c2d
@@ -16,17 +15,10 @@ from qtanimator.document.commands import SetKeys
 from qtanimator.document.document import DocumentChange
 from qtanimator.document.io import save_document
 
-DEMO = Path(__file__).resolve().parents[2] / "scenes" / "demo" / "demo.qtanim"
-
 
 @pytest.fixture
 def demo(make_window, qtbot):
-    window = make_window(editors=("rig_editor", "timeline", "joint_tree", "properties"))
-    assert window.open_path(DEMO)
-    window.central_tabs.setCurrentWidget(window.rig_editor)
-    view = window.rig_editor.view
-    view.fit_view()
-    qtbot.wait(10)
+    window, view = open_demo(make_window, qtbot)
     seen: list[DocumentChange] = []
     window.ctx.documentChanged.connect(seen.append)
     return window, view, seen

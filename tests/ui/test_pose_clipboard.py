@@ -3,17 +3,15 @@ Ctrl+Shift+V in the 2D editor (the demo's Pip) and the 3D view; one undo step ea
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtGui import QAction
+from rig_helpers import open_demo
 
 from qtanimator.document import character2d as c2d
 from qtanimator.ui import rig_interaction as ri
 
-DEMO = Path(__file__).resolve().parents[2] / "scenes" / "demo" / "demo.qtanim"
 COPY_FRAME, PASTE_FRAME = 45.0, 100.0  # the demo has no key at frame 100
 CTRL, SHIFT = Qt.KeyboardModifier.ControlModifier, Qt.KeyboardModifier.ShiftModifier
 
@@ -26,13 +24,7 @@ MIRROR = {"torso": "torso", "head": "head", "leg_left": "leg_right", "leg_right"
 @pytest.fixture
 def demo(make_window, qtbot):
     ri.pose_clipboard.clip = None
-    window = make_window(editors=("rig_editor", "timeline", "joint_tree", "properties"))
-    assert window.open_path(DEMO)
-    window.central_tabs.setCurrentWidget(window.rig_editor)
-    view = window.rig_editor.view
-    view.fit_view()
-    view.setFocus()
-    qtbot.waitUntil(view.hasFocus)
+    window, view = open_demo(make_window, qtbot, focus=True)
     window.ctx.set_frame(COPY_FRAME)
     yield window, view
     ri.pose_clipboard.clip = None

@@ -17,24 +17,13 @@ from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtWidgets import QApplication, QMenu
 from rig_helpers import send_mouse
+from samples import PLAIN_DRAWING
 
 from qtanimator.document import character2d as c2d
 from qtanimator.document import open_document, save_document
 from qtanimator.ui.rig_editor import open_characters
 
-#: A plain drawing: the first element is a <path>, the first layer is empty, then three
-#: layers (body 40x80 at (50, 50), arm 60x10 at (90, 60), hat 20x10 at (60, 30)).
-DRAWING = """<svg xmlns="http://www.w3.org/2000/svg"
- xmlns:inkscape="http://www.inkscape.org/namespaces/inkscape" width="200" height="200">
-<path d="M10 10 L30 10 L30 30 Z" fill="red"/>
-<g inkscape:groupmode="layer" inkscape:label="Empty" id="layer0"/>
-<g inkscape:groupmode="layer" inkscape:label="Body" id="layer1">
-<rect x="50" y="50" width="40" height="80" fill="blue"/></g>
-<g inkscape:groupmode="layer" inkscape:label="Arm"><rect x="90" y="60" width="60" height="10" fill="green"/></g>
-<g inkscape:groupmode="layer" inkscape:label="Hat" id="layer3">
-<rect x="60" y="30" width="20" height="10" fill="black"/></g>
-</svg>
-"""
+DRAWING = PLAIN_DRAWING  # a <path> first, an empty first layer, then three layers
 
 LEFT, RIGHT, NONE = Qt.MouseButton.LeftButton, Qt.MouseButton.RightButton, Qt.MouseButton.NoButton
 

@@ -6,31 +6,24 @@ the simulated frames, and closing the window stops the worker. No wall-clock ass
 from __future__ import annotations
 
 import threading
-from pathlib import Path
 
 import numpy as np
 import pytest
 from PySide6.QtCore import QEvent, QPoint, Qt
 from PySide6.QtWidgets import QApplication, QWidget
-from rig_helpers import hand_point, send_mouse
+from rig_helpers import hand_point, open_demo, send_mouse
 
 from qtanimator.document import character2d as c2d
 from qtanimator.document.document import DocumentChange
 from qtanimator.document.simulation import running_workers, shutdown_all
 from qtanimator.ui.timeline import CACHE_COLOR, CacheBar
 
-DEMO = Path(__file__).resolve().parents[2] / "scenes" / "demo" / "demo.qtanim"
 TIMEOUT_MS = 60_000  # a safety net against hangs, never a performance assertion
 
 
 @pytest.fixture
 def demo(make_window, qtbot):
-    window = make_window(editors=("rig_editor", "timeline", "joint_tree", "properties"))
-    assert window.open_path(DEMO)
-    window.central_tabs.setCurrentWidget(window.rig_editor)
-    view = window.rig_editor.view
-    view.fit_view()
-    qtbot.wait(10)
+    window, view = open_demo(make_window, qtbot)
     yield window, view
     shutdown_all()
     assert running_workers() == []
