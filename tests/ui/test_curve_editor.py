@@ -3,8 +3,8 @@
 from __future__ import annotations
 
 import pytest
-from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
-from PySide6.QtGui import QMouseEvent
+from curve_helpers import drag, hover, key_pos, view_pos, viewport_pos
+from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtWidgets import QApplication
 
 from qtanimator.core.channel import Channel, Extrapolation, Key, Tangent
@@ -41,31 +41,12 @@ def editor(qtbot):
     return ed
 
 
-def viewport_pos(ed: CurveEditor, scene: QPointF) -> QPoint:
-    return ed.plot.mapFromScene(scene)
 
 
-def key_pos(ed: CurveEditor, cid: str, i: int) -> QPoint:
-    return viewport_pos(ed, ed.view.handle_positions(cid, i)[0])
 
 
-def view_pos(ed: CurveEditor, frame: float, value: float) -> QPoint:
-    return viewport_pos(ed, ed.view.vb.mapViewToScene(QPointF(frame, value)))
 
 
-def hover(ed: CurveEditor, pos: QPoint) -> None:
-    """Move the mouse over the plot with no button down, synchronously.
-
-    ``qtbot.mouseMove`` with no button pressed moves the real pointer (``QCursor::setPos``,
-    kept by QTest for compatibility) and, under Xvfb, the window system's move event can
-    arrive after the next assertion: the hover test failed that way in busy full runs.
-    Events already queued are handled first, so no late one lands after this move.
-    """
-    QApplication.processEvents()
-    vp = ed.plot.viewport()
-    ev = QMouseEvent(QEvent.Type.MouseMove, QPointF(pos), QPointF(vp.mapToGlobal(pos)), Qt.MouseButton.NoButton,
-                     Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier)
-    QApplication.sendEvent(vp, ev)
 
 
 def drawn_paths(ed: CurveEditor, cid: str):
@@ -80,17 +61,6 @@ def drawn_paths(ed: CurveEditor, cid: str):
     return keyed, ext, display
 
 
-def drag(qtbot, ed: CurveEditor, start: QPoint, end: QPoint, steps: int = 6,
-         mods=Qt.KeyboardModifier.NoModifier, release: bool = True) -> None:
-    vp = ed.plot.viewport()
-    qtbot.mousePress(vp, Qt.MouseButton.LeftButton, mods, start)
-    for k in range(1, steps + 1):
-        p = start + (end - start) * (k / steps)
-        qtbot.wait(12)  # pyqtgraph drops moves closer than 10 ms apart (mouseRateLimit)
-        qtbot.mouseMove(vp, p)
-    qtbot.wait(12)
-    if release:
-        qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, mods, end)
 
 
 def test_drag_key_moves_it_snapped_and_is_one_undo_step(qtbot, editor):

@@ -11,8 +11,9 @@ import math
 
 import numpy as np
 import pytest
-from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
-from PySide6.QtGui import QMouseEvent, QPainterPath
+from curve_helpers import drag, hover, key_pos, view_pos, viewport_pos
+from PySide6.QtCore import QPoint, QPointF, Qt
+from PySide6.QtGui import QPainterPath
 from PySide6.QtWidgets import QApplication, QMenu
 
 from qtanimator.core.channel import Channel, Key, Tangent
@@ -47,36 +48,14 @@ def editor(qtbot):
     return ed
 
 
-def viewport_pos(ed: CurveEditor, scene: QPointF) -> QPoint:
-    return ed.plot.mapFromScene(scene)
 
 
-def key_pos(ed: CurveEditor, cid: str, i: int) -> QPoint:
-    return viewport_pos(ed, ed.view.handle_positions(cid, i)[0])
 
 
-def view_pos(ed: CurveEditor, frame: float, shown: float) -> QPoint:
-    """Where (frame, value as shown) is on the viewport."""
-    return viewport_pos(ed, ed.view.vb.mapViewToScene(QPointF(frame, shown)))
 
 
-def hover(ed: CurveEditor, pos: QPoint) -> None:
-    """The mouse moves over the plot with no button down (a real move event, delivered now)."""
-    QApplication.processEvents()
-    vp = ed.plot.viewport()
-    ev = QMouseEvent(QEvent.Type.MouseMove, QPointF(pos), QPointF(vp.mapToGlobal(pos)), Qt.MouseButton.NoButton,
-                     Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier)
-    QApplication.sendEvent(vp, ev)
 
 
-def drag(qtbot, ed: CurveEditor, start: QPoint, end: QPoint, steps: int = 6) -> None:
-    vp = ed.plot.viewport()
-    qtbot.mousePress(vp, Qt.MouseButton.LeftButton, pos=start)
-    for k in range(1, steps + 1):
-        qtbot.wait(12)  # pyqtgraph drops moves closer than 10 ms apart
-        qtbot.mouseMove(vp, start + (end - start) * (k / steps))
-    qtbot.wait(12)
-    qtbot.mouseRelease(vp, Qt.MouseButton.LeftButton, pos=end)
 
 
 def click(qtbot, ed: CurveEditor, pos: QPoint, mods=Qt.KeyboardModifier.NoModifier) -> None:

@@ -6,8 +6,8 @@ from __future__ import annotations
 import math
 
 import pytest
-from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
-from PySide6.QtGui import QMouseEvent
+from curve_helpers import hover, key_pos
+from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtTest import QTest
 from PySide6.QtWidgets import QApplication, QWidget
 
@@ -44,8 +44,6 @@ def editor(qtbot):
     return ed
 
 
-def key_pos(ed: CurveEditor, cid: str, i: int) -> QPoint:
-    return ed.plot.mapFromScene(ed.view.handle_positions(cid, i)[0])
 
 
 def view_pos(ed: CurveEditor, frame: float, value: float) -> QPoint:
@@ -58,19 +56,6 @@ def move(qtbot, ed: CurveEditor, pos: QPoint) -> None:
     qtbot.mouseMove(ed.plot.viewport(), pos)
 
 
-def hover(ed: CurveEditor, pos: QPoint) -> None:
-    """Move the mouse over the plot with no button down, synchronously.
-
-    ``qtbot.mouseMove`` with no button pressed moves the real pointer (``QCursor::setPos``,
-    kept by QTest for compatibility) and, under Xvfb, the window system's move event can
-    arrive after the next assertion: the hover test failed that way in busy full runs.
-    Events already queued are handled first, so no late one lands after this move.
-    """
-    QApplication.processEvents()
-    vp = ed.plot.viewport()
-    ev = QMouseEvent(QEvent.Type.MouseMove, QPointF(pos), QPointF(vp.mapToGlobal(pos)), Qt.MouseButton.NoButton,
-                     Qt.MouseButton.NoButton, Qt.KeyboardModifier.NoModifier)
-    QApplication.sendEvent(vp, ev)
 
 
 def counters(ed: CurveEditor) -> dict[str, int]:
