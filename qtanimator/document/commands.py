@@ -150,7 +150,11 @@ def moved_key(key: Key, dt: float, dv: float, time_scale: tuple[float, float] | 
     # shape only if the slope shrinks by it.
     in_slope = key.in_slope / factor if key.in_tangent is Tangent.FIXED else key.in_slope
     out_slope = key.out_slope / factor if key.out_tangent is Tangent.FIXED else key.out_slope
-    return replace(new, in_slope=in_slope, out_slope=out_slope)
+    # A weight is a handle's extent in seconds: it stretches with time.
+    scale = abs(factor)
+    in_weight = None if key.in_weight is None else key.in_weight * scale
+    out_weight = None if key.out_weight is None else key.out_weight * scale
+    return replace(new, in_slope=in_slope, out_slope=out_slope, in_weight=in_weight, out_weight=out_weight)
 
 
 class MoveKeys(SetChannels):

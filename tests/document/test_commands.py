@@ -189,3 +189,21 @@ def test_macro_is_one_step_and_merges_into_its_last_command():
     assert doc.channels == {}
     stack.redo()
     assert doc.channels["hero//x"].evaluate(0.0) == 5.0 and doc.channels["hero//y"].evaluate(0.0) == 6.0
+
+
+def test_scaling_time_stretches_a_weighted_curve_without_changing_its_shape():
+    """Scaling key times by f about a pivot p: the new curve at p + f·(t − p) equals the
+    old one at t (fixed slopes divided by f, handle weights, in seconds, multiplied by f)."""
+    import numpy as np
+
+    from qtanimator.core.channel import Channel, Key, Tangent
+    from qtanimator.document.commands import moved_key
+
+    keys = [Key(0.0, 0.0, Tangent.FIXED, Tangent.FIXED, 0.0, 3.0, out_weight=0.5),
+            Key(1.0, 2.0, Tangent.FIXED, Tangent.FIXED, -1.0, -1.0, in_weight=0.1, out_weight=0.2),
+            Key(2.5, 1.0, Tangent.FIXED, Tangent.FIXED, 0.5, 0.0, in_weight=0.7)]
+    old = Channel(keys)
+    pivot, factor = 0.4, 1.7
+    new = Channel([moved_key(k, 0.0, 0.0, (pivot, factor)) for k in keys])
+    t = np.linspace(0.0, 2.5, 201)
+    np.testing.assert_allclose(new.evaluate(pivot + (t - pivot) * factor), old.evaluate(t), atol=1e-9)
