@@ -154,9 +154,11 @@ class EditorContext(QObject):
             return
         if joint:
             runtime = self.doc.runtime.get(asset)
-            keys = getattr(runtime, "joint_keys", None)
+            keys = getattr(runtime, "joint_keys", None)   # 3D: a property (a list)
             if callable(keys):
-                names = set(keys())
+                keys = keys()
+            if isinstance(keys, list):
+                names = set(keys)
             elif isinstance(getattr(runtime, "joints", None), list):
                 names = {getattr(j, "name", None) for j in runtime.joints}
             else:

@@ -599,10 +599,6 @@ class JointTreePanel(QWidget):
         self.dofs.rebuild()
 
     def _document_changed(self, change: DocumentChange) -> None:
-        asset, joint = self.ctx.selection
-        if change.assets and joint and joint not in [n for n, _p, _d in joint_names(self.ctx.doc, asset)]:
-            # a rig edit (or its undo) removed the selected joint
-            self.ctx.select(asset if asset in self.ctx.doc.assets else "", "")
         if change.assets:
             self.tree.rebuild()
             self.dofs.rebuild()

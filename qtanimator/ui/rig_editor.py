@@ -323,18 +323,12 @@ class RigEditorView(QGraphicsView):
 
     def _on_frame(self, _frame: float) -> None:
         self._poses = None
-        pose_doc.clear_pending(self.ctx.doc)  # an unkeyed pose lasts until the frame changes
         self.viewport().update()
 
     def _on_document(self, change: DocumentChange) -> None:
         if change.assets:
             self.sprites.clear()
             self._sync_items()
-            if self.ctx.selection[0] and self.ctx.selection[0] not in self.ctx.doc.assets:
-                self.ctx.select("", "")
-            elif self.ctx.selection[1] and self.selected_joint_index(self.ctx.selection[0]) is None:
-                # A rig edit (or its undo) removed the selected joint: select its character.
-                self.ctx.select(self.ctx.selection[0], "")
             if self.hover is not None and self.hover[0] not in self.ctx.doc.assets:
                 self.hover = None
             if not self._fitted:

@@ -422,8 +422,6 @@ class TimelinePanel(QWidget):
         layout.addLayout(row)
         layout.addWidget(self.timeline, 1)
         self.frame_box.valueChanged.connect(lambda v: ctx.set_frame(float(v)))
-        # An unkeyed pose (auto-key off) lasts until the frame changes.
-        ctx.frameChanged.connect(lambda _f: pose.clear_pending(ctx.doc))
         ctx.frameChanged.connect(self._sync)
         ctx.documentChanged.connect(lambda _e: self._sync())
         ctx.documentReset.connect(self._sync)

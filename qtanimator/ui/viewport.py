@@ -707,14 +707,7 @@ class Viewport3D(QWidget):
         key = self._joint_key(asset_id, joint)
         self.ctx.select(asset_id, key)
         world = self._pose(asset_id).world_matrices()
-        from qtanimator.document.pose import autokey, clear_pending
-
-        if not getattr(self, "_drops_pending", False):
-            # An unkeyed pose (auto-key off) lasts until the frame changes, with or
-            # without a timeline or a 2D editor in the window.
-            ctx = self.ctx
-            ctx.frameChanged.connect(lambda _f: clear_pending(ctx.doc))
-            self._drops_pending = True
+        from qtanimator.document.pose import autokey
         return {"asset": asset_id, "joint": joint, "anchor": world[joint, :3, 3].copy(),
                 "autokey": autokey(self.ctx.doc), "gesture": self.ctx.begin_gesture(f"IK drag {key}")}
 

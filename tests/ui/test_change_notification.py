@@ -152,3 +152,20 @@ def test_a_change_that_removes_the_selected_asset_or_joint_clears_that_selection
     assert ctx.selection == ("pip", "hand_right")   # still there: kept
     ctx.push(RemoveAsset(ctx.doc, "pip"))
     assert ctx.selection == ("", "") and seen[-1] == ("", "")
+
+
+def test_a_stale_3d_joint_selection_is_dropped_too():
+    """3D characters name their joints by key (``Character3D.joint_keys``, a list)."""
+    from qtanimator.document.commands import RemoveAsset
+    from qtanimator.document.io import open_document
+    from qtanimator.paths import scenes_dir
+    from qtanimator.ui.context import EditorContext
+
+    ctx = EditorContext(open_document(scenes_dir() / "demo" / "demo.qtanim"))
+    real = ctx.doc.runtime["arm"].joint_keys[-1]
+    ctx.select("arm", real)
+    ctx.push(RemoveAsset(ctx.doc, "pendulum_clock"))
+    assert ctx.selection == ("arm", real)
+    ctx.select("arm", "no_such_joint")
+    ctx.push(RemoveAsset(ctx.doc, "robot"))
+    assert ctx.selection == ("arm", "")

@@ -292,9 +292,7 @@ class CurveView(QObject):
         ctx.frameChanged.connect(self._frame_changed)
         ctx.documentChanged.connect(self._document_changed)
         self.keySelectionChanged.connect(self._publish_selection)
-        shared = getattr(ctx, "key_selection", None)
-        if shared is not None:
-            shared.changed.connect(self._shared_selection_changed)
+        ctx.key_selection.changed.connect(self._shared_selection_changed)
         self.vb.sigRangeChanged.connect(lambda *_: self.refresh_all())
         self.vb.sigResized.connect(lambda *_: self.refresh_all())
         start, end = ctx.doc.frame_range
@@ -684,8 +682,8 @@ class CurveView(QObject):
     def _publish_selection(self) -> None:
         """Our selection changed: share it (``ctx.key_selection``). Keys another editor
         selected on channels this view does not show stay selected there."""
-        shared = getattr(self.ctx, "key_selection", None)
-        if shared is None or self._adopting:
+        shared = self.ctx.key_selection
+        if self._adopting:
             return
         channels = self.doc.channels
         shown = set(self.visible)
@@ -701,8 +699,8 @@ class CurveView(QObject):
         self._adopt_shared()
 
     def _adopt_shared(self) -> None:
-        shared = getattr(self.ctx, "key_selection", None)
-        if shared is None or self._drag is not None:
+        shared = self.ctx.key_selection
+        if self._drag is not None:
             return
         shown = set(self.visible)
         wanted = {cid: set(idx) for cid, idx in shared.valid(self.doc.channels).items() if cid in shown}
