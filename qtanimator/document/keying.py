@@ -176,7 +176,7 @@ def _moved_channels(doc: Document, selection: Selection, base: Mapping[str, Chan
         chosen = set(idx)
         placed = [(*move(old, i), i) for i in idx]
         new, where = _place(old, (k for i, k in enumerate(old.keys) if i not in chosen), placed)
-        changes[cid] = (old, new if new != old else old)
+        changes[cid] = (old, new if new != old else old)  # unchanged: keep the object
         new_selection[cid] = where
     return KeyEdit(SetChannels(text, changes), new_selection)
 

@@ -271,6 +271,13 @@ def _user_id(el: Any) -> str | None:
     return str(v) if v else None
 
 
+
+def _box_centre(points: list[np.ndarray]) -> np.ndarray:
+    """The centre of the bounding box of some point arrays. Halves first: the midpoint of
+    coordinates near the float limit does not overflow (and equals (min + max) / 2 else)."""
+    allp = np.concatenate(points)
+    return np.asarray(allp.min(axis=0) / 2.0 + allp.max(axis=0) / 2.0, dtype=np.float64)
+
 class _Builder:
     def __init__(self, path: str | os.PathLike[str] | None) -> None:
         self.path = path
@@ -360,9 +367,7 @@ class _Builder:
         if not pts:
             raise _NotARig(f"joint {index} ('{name}') has no centre circle and its last element "
                            "has no geometry to take a centre from.", self.path)
-        allp = np.concatenate(pts)
-        # Halves first: the midpoint of coordinates near the float limit does not overflow.
-        c = allp.min(axis=0) / 2.0 + allp.max(axis=0) / 2.0
+        c = _box_centre(pts)
         self.warnings.append(f"joint {index} ('{name}'): the last element is a <{_tag(el)}>, not a "
                              f"<circle>; using its bounding-box centre ({c[0]:.3f}, {c[1]:.3f}) as the pivot.")
         return c, white
@@ -576,11 +581,7 @@ def _whole_drawing(svg: Any, top: list[Any], root: ET.Element,
     for el in top:
         shapes.extend(builder.shapes(el))
     pts = [s.points for s in shapes if len(s.points)]
-    if pts:
-        allp = np.concatenate(pts)
-        pivot = (allp.min(axis=0) + allp.max(axis=0)) / 2.0
-    else:
-        pivot = np.zeros(2)
+    pivot = _box_centre(pts) if pts else np.zeros(2)
     builder.joints.append(Joint(builder._name("drawing"), None, pivot, False, shapes))
     builder.scopes.append(({root.get(_QID, "0")}, set()))
     _add_candidates(builder, top, root)
@@ -979,8 +980,7 @@ def _from_spec(svg: Any, top: list[Any], root: ET.Element, spec: Any, refs: dict
             pivot = np.array([_float(pivot_v[0]), _float(pivot_v[1])], dtype=np.float64)
         else:
             pts = [s.points for s in shapes if len(s.points)]
-            allp = np.concatenate(pts) if pts else np.zeros((1, 2))
-            pivot = (allp.min(axis=0) + allp.max(axis=0)) / 2.0
+            pivot = _box_centre(pts) if pts else np.zeros(2)
         parent = None if r.get("parent") is None else index[r["parent"]]
         builder._names.add(name)
         builder.joints.append(Joint(name, parent, pivot, bool(r.get("dynamic", False)), shapes))
