@@ -237,6 +237,7 @@ class Channel:
     pre: Extrapolation = Extrapolation.CONSTANT
     post: Extrapolation = Extrapolation.CONSTANT
     _compiled: list[_Compiled] = field(default_factory=list, repr=False, compare=False, hash=False)
+    _derived: dict[str, Any] = field(default_factory=dict, repr=False, compare=False, hash=False)
 
     def __init__(self, keys: Iterable[Key] = (), pre: Extrapolation | str = Extrapolation.CONSTANT,
                  post: Extrapolation | str = Extrapolation.CONSTANT) -> None:
@@ -248,6 +249,7 @@ class Channel:
         object.__setattr__(self, "pre", Extrapolation(pre))
         object.__setattr__(self, "post", Extrapolation(post))
         object.__setattr__(self, "_compiled", [])
+        object.__setattr__(self, "_derived", {})
 
     def __hash__(self) -> int:
         return hash((self.keys, self.pre, self.post))
@@ -263,6 +265,16 @@ class Channel:
     @property
     def values(self) -> FloatArray:
         return self._compile().values
+
+    @property
+    def linear_spans(self) -> npt.NDArray[np.bool_]:
+        """Per span (key i to key i + 1) whether it is linear; computed once per channel."""
+        found = self._derived.get("linear_spans")
+        if found is None:
+            found = np.array([k.interpolation is Interpolation.LINEAR for k in self.keys[:-1]], dtype=bool)
+            self._derived["linear_spans"] = found
+        result: npt.NDArray[np.bool_] = found
+        return result
 
     def with_keys(self, keys: Iterable[Key]) -> Channel:
         return Channel(keys, self.pre, self.post)

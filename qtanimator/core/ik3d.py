@@ -85,15 +85,15 @@ def jacobian(skeleton: Skeleton, values: npt.ArrayLike, dofs: Sequence[DofRef],
     world = skeleton.world_matrices(v)
     p_end = world[end, :3, 3].copy()
     jac = np.zeros((3, len(dofs)))
-    root = np.eye(4)
-    root[:3, 3] = skeleton.root_translation
+    root = np.eye(4) if skeleton.placement is None else skeleton.placement.copy()
+    root[:3, 3] += root[:3, :3] @ skeleton.root_translation
     frames: dict[int, FloatArray] = {}
     for col, (j, a) in enumerate(dofs):
         joint = skeleton.joints[j]
         if j not in frames:
             parent = root if joint.parent is None else world[joint.parent]
             f = parent.copy()
-            f[:3, 3] = parent[:3, :3] @ joint.offset + parent[:3, 3]
+            f[:3, 3] = parent[:3, :3] @ (joint.offset + joint.translation) + parent[:3, 3]
             frames[j] = f
         f = frames[j]
         order = joint.rotation_order or skeleton.rotation_order
@@ -103,6 +103,7 @@ def jacobian(skeleton: Skeleton, values: npt.ArrayLike, dofs: Sequence[DofRef],
             i = AXES.index(letter)
             pre = pre @ axis_rotations(i, v[j, i])[0]
         axis = f[:3, :3] @ pre[:, a]
+        axis /= np.linalg.norm(axis) or 1.0  # a scaled parent (glTF) turns the joint about a unit axis
         jac[:, col] = np.cross(axis, p_end - f[:3, 3])
     return p_end, jac
 

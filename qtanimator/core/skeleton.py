@@ -2,12 +2,18 @@
 
 Conventions (ARCHITECTURE section 4): right-handed, y up, column vectors, float64.
 
-* A joint's local matrix is ``T(offset) · R`` where ``R`` multiplies the three axis
-  rotations in the skeleton's :attr:`Skeleton.rotation_order`, read left to right:
-  ``"zyx"`` (balljoint ``.skel``) is ``Rz(θz)·Ry(θy)·Rx(θx)`` and ``"xyz"`` (MIT ``.skel``)
-  is ``Rx·Ry·Rz``. A joint may override the order (BVH gives one per joint).
-* World matrices: ``W_root = T(root_translation) · L_root``, ``W_j = W_parent · L_j``,
-  computed by a depth-first traversal on a :class:`~qtanimator.core.matrix_stack.MatrixStack`.
+* A joint's local matrix is ``T(offset + translation) · R · S(scale)`` where ``R``
+  multiplies the three axis rotations in the skeleton's :attr:`Skeleton.rotation_order`,
+  read left to right: ``"zyx"`` (balljoint ``.skel``) is ``Rz(θz)·Ry(θy)·Rx(θx)`` and
+  ``"xyz"`` (MIT ``.skel``) is ``Rx·Ry·Rz``. A joint may override the order (BVH gives one
+  per joint). Course skeletons only turn (translation 0, scale 1); joints from glTF also
+  move and scale (issue 21).
+* The pose is always held as Euler DOF values. A joint whose rotation is *keyed* as a
+  quaternion (:attr:`Joint.quaternion`, glTF) is interpolated as one by the document, which
+  then poses the joint with the equivalent Euler angles: the matrix is the same.
+* World matrices: ``W_root = placement · T(root_translation) · L_root``,
+  ``W_j = W_parent · L_j``, computed by a depth-first traversal on a
+  :class:`~qtanimator.core.matrix_stack.MatrixStack`. Several roots are allowed.
 * DOF values are clamped to their limits whenever they are set.
 """
 
@@ -21,11 +27,15 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.matrix_stack import MatrixStack
+from qtanimator.core.rotation import AXES, ROTATION_ORDERS, axis_rotations, rotation_matrices
 
 FloatArray = npt.NDArray[np.float64]
 
-AXES = ("x", "y", "z")
-ROTATION_ORDERS = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx")
+__all__ = [
+    "AXES", "DEFAULT_BOXMAX", "DEFAULT_BOXMIN", "DEFAULT_LIMIT", "ROTATION_ORDERS", "Dof", "Joint", "Skeleton",
+    "axis_index", "axis_rotations", "rotation_matrices",
+]
+
 DEFAULT_LIMIT = 100000.0
 DEFAULT_BOXMIN = (-0.1, -0.1, -0.1)
 DEFAULT_BOXMAX = (0.1, 0.1, 0.1)
@@ -73,6 +83,9 @@ class Dof:
         return f"Dof({self._value!r}, {self.min!r}, {self.max!r})"
 
 
+_ONES = np.ones(3)
+
+
 def _vec3(v: Sequence[float] | FloatArray) -> FloatArray:
     a = np.array(v, dtype=np.float64).reshape(3)
     return a
@@ -90,9 +103,22 @@ class Joint:
     boxmax: FloatArray = field(default_factory=lambda: np.array(DEFAULT_BOXMAX))
     #: None: use the skeleton's rotation order.
     rotation_order: str | None = None
+    #: The pose's translation, added to the offset (0 for joints that only turn).
+    translation: FloatArray = field(default_factory=lambda: np.zeros(3))
+    #: The pose's scale along the joint's own axes (1 for joints that do not scale).
+    scale: FloatArray = field(default_factory=lambda: np.ones(3))
+    #: The rotation is keyed as a quaternion (channels qw, qx, qy, qz; glTF) instead of
+    #: three Euler angles.
+    quaternion: bool = False
+    #: The joint has translation channels (tx, ty, tz) besides its rotation.
+    translates: bool = False
+    #: The joint has scale channels (sx, sy, sz).
+    scales: bool = False
 
     def __post_init__(self) -> None:
         self.offset = _vec3(self.offset)
+        self.translation = _vec3(self.translation)
+        self.scale = _vec3(self.scale)
         self.boxmin = _vec3(self.boxmin)
         self.boxmax = _vec3(self.boxmax)
         if len(self.dofs) != 3:
@@ -109,7 +135,8 @@ class Joint:
     def copy(self) -> Joint:
         return Joint(self.name, self.parent, self.offset.copy(),
                      (self.dofs[0].copy(), self.dofs[1].copy(), self.dofs[2].copy()),
-                     self.boxmin.copy(), self.boxmax.copy(), self.rotation_order)
+                     self.boxmin.copy(), self.boxmax.copy(), self.rotation_order, self.translation.copy(),
+                     self.scale.copy(), self.quaternion, self.translates, self.scales)
 
 
 def axis_index(axis: str | int) -> int:
@@ -120,30 +147,6 @@ def axis_index(axis: str | int) -> int:
     elif isinstance(axis, str) and axis.lower() in AXES:
         return AXES.index(axis.lower())
     raise ValueError(f"axis must be 'x', 'y' or 'z', got {axis!r}")
-
-
-def axis_rotations(axis: int, angles: npt.ArrayLike) -> FloatArray:
-    """(N, 3, 3) right-handed rotations about x (0), y (1) or z (2) by ``angles`` radians."""
-    a = np.asarray(angles, dtype=np.float64).reshape(-1)
-    c, s = np.cos(a), np.sin(a)
-    r = np.zeros((a.shape[0], 3, 3))
-    i, j = [(1, 2), (2, 0), (0, 1)][axis]
-    r[:, axis, axis] = 1.0
-    r[:, i, i] = c
-    r[:, j, j] = c
-    r[:, i, j] = -s
-    r[:, j, i] = s
-    return r
-
-
-def rotation_matrices(angles: npt.ArrayLike, order: str) -> FloatArray:
-    """(N, 3) angles (x, y, z) → (N, 3, 3) rotations, the axis factors multiplied in ``order``."""
-    if order not in ROTATION_ORDERS:
-        raise ValueError(f"unknown rotation order {order!r}")
-    a = np.asarray(angles, dtype=np.float64).reshape(-1, 3)
-    i, j, k = (AXES.index(ch) for ch in order)
-    result: FloatArray = axis_rotations(i, a[:, i]) @ axis_rotations(j, a[:, j]) @ axis_rotations(k, a[:, k])
-    return result
 
 
 class Skeleton:
@@ -159,6 +162,8 @@ class Skeleton:
         #: where the skeleton came from: "balljoint", "mit", "bvh", "gltf" or "".
         self.dialect = dialect
         self.root_translation: FloatArray = np.zeros(3)
+        #: A fixed matrix above every root (glTF: the nodes above the skeleton); None: identity.
+        self.placement: FloatArray | None = None
         for i, j in enumerate(self.joints):
             if j.parent is not None and not (0 <= j.parent < i):
                 raise ValueError(f"joint {i} ({j.name!r}) has parent {j.parent}, which does not precede it")
@@ -255,12 +260,13 @@ class Skeleton:
         s.name = self.name
         s.dialect = self.dialect
         s.root_translation = self.root_translation.copy()
+        s.placement = None if self.placement is None else self.placement.copy()
         s._depths = list(self._depths)
         return s
 
     # ---------------------------------------------------------------- matrices
     def local_matrices(self, dof_values: npt.ArrayLike | None = None) -> FloatArray:
-        """(J, 4, 4) local matrices ``T(offset)·R`` for the current (or given) DOF values."""
+        """(J, 4, 4) local matrices ``T(offset + translation)·R·S`` for the current (or given) DOF values."""
         n = len(self.joints)
         angles = self.dof_values() if dof_values is None else np.asarray(dof_values, np.float64).reshape(n, 3)
         out = np.zeros((n, 4, 4))
@@ -270,7 +276,10 @@ class Skeleton:
             mask = np.array([o == order for o in orders])
             out[mask, :3, :3] = rotation_matrices(angles[mask], order)
         if n:
-            out[:, :3, 3] = np.array([j.offset for j in self.joints])
+            out[:, :3, 3] = np.array([j.offset + j.translation for j in self.joints])
+            scaled = [i for i, j in enumerate(self.joints) if not np.array_equal(j.scale, _ONES)]
+            if scaled:
+                out[scaled, :3, :3] *= np.array([self.joints[i].scale for i in scaled])[:, None, :]
         return out
 
     def world_matrices(self, dof_values: npt.ArrayLike | None = None,
@@ -287,6 +296,8 @@ class Skeleton:
         if n == 0:
             return world
         stack = MatrixStack(max(self._depths) + 3)
+        if self.placement is not None:
+            stack.load(self.placement)
         stack.translate(float(rt[0]), float(rt[1]), float(rt[2]))
         chain: list[int] = []  # the joint whose world matrix sits at each pushed level
         for i, joint in enumerate(self.joints):

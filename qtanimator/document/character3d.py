@@ -11,10 +11,21 @@ Channels (document channel ids):
 
 * ``"<asset>//tx"``, ``"<asset>//ty"``, ``"<asset>//tz"``: root translation;
 * ``"<asset>/<joint key>/rx|ry|rz"``: joint rotations (radians), where the joint key is
-  the joint's name, or ``name#index`` when several joints share the name (the dragon).
+  the joint's name, or ``name#index`` when several joints share the name (the dragon);
+* for a joint whose rotation is keyed as a quaternion (glTF), ``qw|qx|qy|qz`` instead
+  (evaluated as one rotation: :mod:`qtanimator.core.quaternion_channels`);
+* for a joint that moves or scales (glTF), ``tx|ty|tz`` (added to its offset) and
+  ``sx|sy|sz``.
 
-A DOF with no channel keeps the value the ``.skel`` file gave it. Channel values are
-clamped to the DOF limits when the skeleton is posed.
+A DOF with no channel keeps the value the file gave it. Channel values are clamped to the
+DOF limits when the skeleton is posed.
+
+A character from glTF may have several **clips** (the file's animations,
+:class:`ClipSource`). The document's channels hold the active clip (asset property
+``clip``); :func:`set_clip_command` makes another clip active, putting the edited channels
+of the one left in the asset property ``clip_store`` so that they survive (and are saved).
+Its meshes are :class:`MeshPart` ranges of one merged skin whose joint slots map to
+skeleton joints through :attr:`Character3D.palette`.
 """
 
 from __future__ import annotations
@@ -28,9 +39,11 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from qtanimator.core.channel import Channel, Key
+from qtanimator.core.channel import Channel, Interpolation, Key, Tangent
 from qtanimator.core.clip import ROOT, AnimationClip, channel_count, channel_target
-from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Skeleton, axis_index
+from qtanimator.core.quaternion_channels import QUATERNION_DOFS, quaternions_at
+from qtanimator.core.rotation import euler_to_quaternions, quaternions_to_euler, same_hemisphere
+from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skeleton, axis_index
 from qtanimator.core.skinning import (
     Skin,
     SkinBinding,
@@ -39,7 +52,15 @@ from qtanimator.core.skinning import (
     skin_positions_and_normals,
     vertex_normals,
 )
-from qtanimator.document.commands import AddAsset, Command, Macro, SetAssetProperty, SetChannels, SetKeys
+from qtanimator.document.commands import (
+    AddAsset,
+    Command,
+    Macro,
+    SetAssetProperty,
+    SetChannels,
+    SetKeys,
+    SetParameter,
+)
 from qtanimator.document.document import Asset, Document, channel_id
 from qtanimator.document.pose import pending_values
 from qtanimator.formats.anim import load_anim
@@ -55,14 +76,56 @@ FloatArray = npt.NDArray[np.float64]
 ASSET_KIND = "character3d"
 ROOT_DOFS = ("tx", "ty", "tz")
 JOINT_DOFS = ("rx", "ry", "rz")
+QUAT_DOFS = QUATERNION_DOFS
+TRANSLATE_DOFS = ("tx", "ty", "tz")
+SCALE_DOFS = ("sx", "sy", "sz")
+#: The asset properties of the active clip's name and of the clips edited and left.
+CLIP = "clip"
+CLIP_STORE = "clip_store"
 
 __all__ = [
-    "ASSET_KIND", "BVH_POSITIONS", "BvhCharacter", "Character3D", "add_character3d_command", "bvh_positions",
-    "bvh_positions_note", "channel_dofs", "channel_ids", "character", "clip_from_document", "dof_channel_id",
-    "dof_values", "ik_values", "load_anim_command", "load_bvh_character", "load_character3d",
-    "load_character3d_asset", "pose_skeleton", "set_bvh_positions_command", "set_dof_command",
-    "set_dofs_command", "skinned_mesh", "world_matrices",
+    "ASSET_KIND", "BVH_POSITIONS", "BvhCharacter", "CLIP", "CLIP_STORE", "Character3D", "ClipSource", "MeshPart",
+    "QUAT_DOFS", "SCALE_DOFS", "TRANSLATE_DOFS", "active_clip", "add_character3d_command", "all_channel_ids",
+    "bvh_positions", "bvh_positions_note", "channel_dofs", "channel_ids", "character", "clip_channels_of",
+    "clip_from_document", "clip_range_command", "dof_channel_id", "dof_values", "ik_values", "joint_channel_names",
+    "load_anim_command", "load_bvh_character", "load_character3d", "load_character3d_asset", "new_key",
+    "pose_channel_values",
+    "pose_skeleton", "set_bvh_positions_command", "set_clip_command", "set_dof_command", "set_dofs_command",
+    "skinned_mesh", "world_matrices",
 ]
+
+
+@dataclass
+class MeshPart:
+    """One mesh of a character: vertices ``start … start + count`` and triangles
+    ``triangle_start …`` of the merged skin. ``node`` / ``mesh`` / ``primitive`` say where
+    it came from in a glTF file (None for course files)."""
+
+    name: str
+    start: int
+    count: int
+    triangle_start: int = 0
+    triangle_count: int = 0
+    skinned: bool = True
+    node: int | None = None
+    mesh: int | None = None
+    primitive: int = 0
+    #: base colour (RGBA, linear) of the part's material
+    color: tuple[float, float, float, float] = (0.8, 0.8, 0.8, 1.0)
+
+
+@dataclass
+class ClipSource:
+    """An animation the character's file brought: its name, where it lies in the file's
+    time, and its channels keyed by the asset-relative id (``"<joint key>/<dof>"``,
+    ``"/tx"`` for the root translation)."""
+
+    name: str
+    start: float
+    end: float
+    channels: dict[str, Channel] = field(default_factory=dict)
+    #: the animation's index in the file (None: not from a file)
+    index: int | None = None
 
 
 @dataclass(eq=False)
@@ -75,10 +138,39 @@ class Character3D:
     clip: AnimationClip | None = None
     #: MIT meshes are drawn with per-face normals by default.
     faceted: bool = False
+    #: The meshes of the merged skin (empty: the skin is one mesh).
+    parts: list[MeshPart] = field(default_factory=list)
+    #: The animations of the file (glTF); the document's channels hold the active one.
+    clips: list[ClipSource] = field(default_factory=list)
+    #: Skin joint slot → skeleton joint (None: slot i is joint i). Several glTF skins (each
+    #: with its own inverse bind matrices) and rigid parts share one merged skin this way.
+    palette: npt.NDArray[np.intp] | None = None
+    #: Notes for the user from reading the file.
+    notes: list[str] = field(default_factory=list)
+    _rest_quaternions: FloatArray | None = field(default=None, repr=False)
 
     @property
     def joint_keys(self) -> list[str]:
         return self.skeleton.joint_keys()
+
+    def skinning_world(self, world: FloatArray) -> FloatArray:
+        """The world matrices of the skin's joint slots from the skeleton's (J, 4, 4)."""
+        return world if self.palette is None else world[self.palette]
+
+    def clip_named(self, name: str) -> ClipSource | None:
+        return next((c for c in self.clips if c.name == name), None)
+
+    def rest_quaternions(self) -> FloatArray:
+        """(J, 4) the rest pose's rotations as quaternions (what a quaternion joint holds
+        where a component has no channel)."""
+        if self._rest_quaternions is None:
+            sk = self.skeleton
+            out = np.tile(np.array([0.0, 0.0, 0.0, 1.0]), (len(sk.joints), 1))
+            for i, j in enumerate(sk.joints):
+                if j.quaternion:
+                    out[i] = euler_to_quaternions(j.pose, j.rotation_order or sk.rotation_order)[0]
+            self._rest_quaternions = out
+        return self._rest_quaternions
 
 
 def load_character3d(skel_path: str | os.PathLike[str], skin_path: str | os.PathLike[str] | None = None,
@@ -121,6 +213,14 @@ class BvhCharacter(Character3D):
     positions: str = "relative"
     detected: str = "relative"
     notes: list[str] = field(default_factory=list)
+    #: Joint index → x, y, z translation channels of the joints below the root that move.
+    translations: dict[int, list[Channel | None]] = field(default_factory=dict)
+
+    def translation_channels(self, asset_id: str) -> dict[str, Channel]:
+        """The translation channels of the joints that move, by document channel id."""
+        keys = self.joint_keys
+        return {channel_id(asset_id, keys[j], TRANSLATE_DOFS[a]): c
+                for j, chans in self.translations.items() for a, c in enumerate(chans) if c is not None}
 
 
 #: The asset property holding a BVH character's position convention (absent: detected).
@@ -137,8 +237,9 @@ def load_bvh_character(path: str | os.PathLike[str],
     the file's numbers either way: the convention only sets the offsets (absolute: the
     root's OFFSET is 0 on its position axes, so the channel replaces it).
 
-    The skeleton's DOFs hold the first frame's pose. Raises FormatError for a bad file or a
-    hierarchy a skeleton cannot hold (several roots, a joint below the root that moves).
+    The skeleton's DOFs hold the first frame's pose; joints below the root that move have
+    translation channels (:attr:`BvhCharacter.translations`). Raises FormatError for a bad
+    file or a hierarchy a skeleton cannot hold (several roots).
     """
     clip = load_bvh(path)
     if positions is not None and positions not in POSITION_CONVENTIONS:
@@ -146,7 +247,7 @@ def load_bvh_character(path: str | os.PathLike[str],
                           "'absolute'.", path)
     chosen = positions or clip.positions
     try:
-        skeleton, channels = clip.to_skeleton(chosen)
+        skeleton, channels, moving = clip.to_skeleton(chosen)
     except ValueError as exc:
         raise FormatError(f"{exc}.", path) from exc
     skeleton.dialect = "bvh"
@@ -155,7 +256,8 @@ def load_bvh_character(path: str | os.PathLike[str],
         joint.boxmin = np.array(DEFAULT_BOXMIN)
         joint.boxmax = np.array(DEFAULT_BOXMAX)
     notes = [bvh_positions_note(chosen, clip.positions), *clip.warnings]
-    return BvhCharacter(skeleton, positions=chosen, detected=clip.positions, notes=notes), channels
+    return BvhCharacter(skeleton, positions=chosen, detected=clip.positions, notes=notes,
+                        translations=moving), channels
 
 
 def bvh_positions_note(chosen: str, detected: str) -> str:
@@ -214,7 +316,7 @@ def set_bvh_positions_command(doc: Document, asset_id: str, value: str) -> Comma
         for joint, new in zip(skeleton.joints, runtime.skeleton.joints):
             joint.offset = new.offset.copy()
         runtime = BvhCharacter(skeleton, old.skin, old.mesh, old.clip, old.faceted, positions=value,
-                               detected=runtime.detected, notes=runtime.notes)
+                               detected=runtime.detected, notes=runtime.notes, translations=runtime.translations)
     return _SetBvhPositions(doc, asset_id, value, runtime)
 
 
@@ -254,6 +356,19 @@ def _dof_name(joint_index: int | None, axis: str | int) -> tuple[bool, int]:
     return (joint_index is None or joint_index == ROOT), axis_index(axis)
 
 
+def _dof_kind(joint_index: int | None, axis: str | int) -> tuple[str, int]:
+    """``("root" | "rotate" | "translate" | "scale", axis 0..2)`` of a DOF: ``(None, "tx")``
+    is the root translation, ``(j, "x" | "rx")`` a rotation, ``(j, "tx")`` / ``(j, "sx")``
+    a joint's translation / scale."""
+    if joint_index is not None and joint_index != ROOT and isinstance(axis, str) and len(axis) == 2:
+        if axis[0] == "t":
+            return "translate", axis_index(axis[1])
+        if axis[0] == "s":
+            return "scale", axis_index(axis[1])
+    root, a = _dof_name(joint_index, axis)
+    return ("root" if root else "rotate"), a
+
+
 def _channel_ids(asset_id: str, keys: list[str]) -> list[str]:
     ids = [channel_id(asset_id, "", d) for d in ROOT_DOFS]
     for key in keys:
@@ -262,23 +377,57 @@ def _channel_ids(asset_id: str, keys: list[str]) -> list[str]:
 
 
 def channel_ids(doc: Document, asset_id: str) -> list[str]:
-    """Every DOF's channel id in ``.anim`` order (root tx, ty, tz, then rx, ry, rz per joint)."""
+    """The ``.anim`` layout's channel ids (root tx, ty, tz, then rx, ry, rz per joint).
+    Joints keyed as quaternions, and translations and scales, are not in it: see
+    :func:`all_channel_ids`."""
     return _channel_ids(asset_id, character(doc, asset_id).joint_keys)
 
 
+def joint_channel_names(joint: Joint) -> list[str]:
+    """The channel names a joint can have: its rotation (Euler or quaternion), then its
+    translation and scale where it moves or scales."""
+    names = list(QUAT_DOFS if joint.quaternion else JOINT_DOFS)
+    if joint.translates:
+        names += TRANSLATE_DOFS
+    if joint.scales:
+        names += SCALE_DOFS
+    return names
+
+
+def all_channel_ids(doc: Document, asset_id: str) -> list[str]:
+    """Every channel id the character can have: the root translation, then per joint
+    :func:`joint_channel_names`."""
+    skel = character(doc, asset_id).skeleton
+    ids = [channel_id(asset_id, "", d) for d in ROOT_DOFS]
+    for key, joint in zip(skel.joint_keys(), skel.joints):
+        ids.extend(channel_id(asset_id, key, d) for d in joint_channel_names(joint))
+    return ids
+
+
 def dof_channel_id(doc: Document, asset_id: str, joint_index: int | None, axis: str | int) -> str:
-    """Channel id of one DOF. ``joint_index`` None (or −1) means the root translation."""
-    root, a = _dof_name(joint_index, axis)
-    if root:
+    """Channel id of one DOF. ``joint_index`` None (or −1) means the root translation.
+
+    A joint's rotation axis ("x" or "rx") names its Euler channel; for a joint keyed as a
+    quaternion, whose rotation lives in four channels, it names the ``q`` channel of that
+    axis (``qx``), the one a key at this time shows up on."""
+    kind, a = _dof_kind(joint_index, axis)
+    if kind == "root":
         return channel_id(asset_id, "", ROOT_DOFS[a])
-    keys = character(doc, asset_id).joint_keys
+    ch = character(doc, asset_id)
+    keys = ch.joint_keys
     if joint_index is None or not 0 <= joint_index < len(keys):
         raise IndexError(f"joint {joint_index} does not exist in {asset_id!r}")
+    if kind == "translate":
+        return channel_id(asset_id, keys[joint_index], TRANSLATE_DOFS[a])
+    if kind == "scale":
+        return channel_id(asset_id, keys[joint_index], SCALE_DOFS[a])
+    if ch.skeleton.joints[joint_index].quaternion:
+        return channel_id(asset_id, keys[joint_index], QUAT_DOFS[1 + a])
     return channel_id(asset_id, keys[joint_index], JOINT_DOFS[a])
 
 
 def channel_dofs(doc: Document, asset_id: str) -> dict[str, tuple[int | None, str]]:
-    """Channel id → ``(joint index or None for the root, axis "x"|"y"|"z")``."""
+    """Channel id → ``(joint index or None for the root, axis "x"|"y"|"z")`` (``.anim`` layout)."""
     out: dict[str, tuple[int | None, str]] = {}
     for i, cid in enumerate(channel_ids(doc, asset_id)):
         joint, axis = channel_target(i)
@@ -337,32 +486,85 @@ def load_anim_command(doc: Document, asset_id: str, anim_path: str | os.PathLike
     ])
 
 
-def _clamped(doc: Document, asset_id: str, joint_index: int | None, axis: str | int, value: float) -> float:
-    root, a = _dof_name(joint_index, axis)
-    if root or joint_index is None:
-        return float(value)
-    return character(doc, asset_id).skeleton.joints[joint_index].dofs[a].clamp(value)
-
-
 def set_dof_command(doc: Document, asset_id: str, joint_index: int | None, axis: str | int, value: float,
                     time: float, gesture: Hashable | None = None) -> Command:
     """Key one DOF at ``time`` (value clamped to the DOF's limits)."""
     return set_dofs_command(doc, asset_id, {(joint_index, axis): value}, time, gesture)
 
 
-def dof_values(doc: Document, asset_id: str,
-               values: Mapping[tuple[int | None, str | int], float]) -> dict[str, float]:
-    """Channel values for DOF values: ``values`` maps (joint, axis) to a value, clamped
-    to the DOF's limits. What a key or an unkeyed pose of those DOFs holds."""
-    return {dof_channel_id(doc, asset_id, joint, axis): _clamped(doc, asset_id, joint, axis, v)
-            for (joint, axis), v in values.items()}
+def dof_values(doc: Document, asset_id: str, values: Mapping[tuple[int | None, str | int], float],
+               time: float | None = None) -> dict[str, float]:
+    """Channel values for DOF values: what a key or an unkeyed pose of those DOFs holds.
+
+    ``values`` maps ``(joint, axis)`` to a value (see :func:`_dof_kind`): rotations in
+    radians (Euler, clamped to the DOF's limits), translations and scales as they are. A
+    joint keyed as a quaternion gets all four components: its Euler angles are the given
+    ones over the pose shown at ``time`` (the rest pose when None), and the quaternion is
+    kept on the side of the one shown (so cubic spans do not flip)."""
+    ch = character(doc, asset_id)
+    skel = ch.skeleton
+    keys = ch.joint_keys
+    out: dict[str, float] = {}
+    turned: dict[int, dict[int, float]] = {}
+    for (joint, axis), v in values.items():
+        kind, a = _dof_kind(joint, axis)
+        if kind == "root":
+            out[channel_id(asset_id, "", ROOT_DOFS[a])] = float(v)
+            continue
+        assert joint is not None
+        if not 0 <= joint < len(keys):
+            raise IndexError(f"joint {joint} does not exist in {asset_id!r}")
+        if kind == "translate":
+            out[channel_id(asset_id, keys[joint], TRANSLATE_DOFS[a])] = float(v)
+        elif kind == "scale":
+            out[channel_id(asset_id, keys[joint], SCALE_DOFS[a])] = float(v)
+        elif skel.joints[joint].quaternion:
+            turned.setdefault(joint, {})[a] = float(v)
+        else:
+            out[channel_id(asset_id, keys[joint], JOINT_DOFS[a])] = skel.joints[joint].dofs[a].clamp(v)
+    if turned:
+        shown = skel if time is None else pose_skeleton(doc, asset_id, time)
+        for joint, axes in turned.items():
+            j = shown.joints[joint]
+            euler = j.pose
+            for a, v in axes.items():
+                euler[a] = j.dofs[a].clamp(v)
+            q = euler_to_quaternions(euler, j.rotation_order or shown.rotation_order)[0]
+            ref = _shown_quaternion(doc, asset_id, joint, time)
+            q = same_hemisphere(q, ref)
+            for slot, name in zip((3, 0, 1, 2), QUAT_DOFS):
+                out[channel_id(asset_id, keys[joint], name)] = float(q[slot])
+    return out
+
+
+def _shown_quaternion(doc: Document, asset_id: str, joint: int, time: float | None) -> FloatArray:
+    """The quaternion components a joint's channels hold at ``time`` (not normalised, sign
+    as keyed); the rest rotation where there are none."""
+    ch = character(doc, asset_id)
+    rest = ch.rest_quaternions()[joint]
+    if time is None:
+        return rest
+    key = ch.joint_keys[joint]
+    out = rest.copy()
+    for slot, name in zip((3, 0, 1, 2), QUAT_DOFS):
+        c = doc.channels.get(channel_id(asset_id, key, name))
+        if c is not None and c.keys:
+            out[slot] = c.evaluate(float(time))
+    return out
+
+
+def new_key(cid: str, time: float, value: float) -> Key:
+    """A new key; quaternion components are keyed linear (a slerp span, as glTF's LINEAR)."""
+    if cid.rsplit("/", 1)[-1] in QUAT_DOFS:
+        return Key(float(time), value, Tangent.LINEAR, Tangent.LINEAR, interpolation=Interpolation.LINEAR)
+    return Key(float(time), value)
 
 
 def set_dofs_command(doc: Document, asset_id: str, values: Mapping[tuple[int | None, str | int], float],
                      time: float, gesture: Hashable | None = None) -> Command:
     """Key several DOFs at ``time`` in one undo step; ``values`` maps (joint, axis) to a value."""
-    keys = {cid: Key(float(time), v) for cid, v in dof_values(doc, asset_id, values).items()}
-    text = "Set Joint" if len(keys) == 1 else "Set Pose"
+    keys = {cid: new_key(cid, time, v) for cid, v in dof_values(doc, asset_id, values, time).items()}
+    text = "Set Joint" if len(values) == 1 else "Set Pose"
     return SetKeys(doc, keys, text=text, gesture=gesture)
 
 
@@ -397,28 +599,180 @@ def clip_from_document(doc: Document, asset_id: str, start: float | None = None,
     return AnimationClip(channels, t0, max(t0, t1))
 
 
+# ------------------------------------------------------------------------- clips
+def active_clip(doc: Document, asset_id: str) -> ClipSource | None:
+    """The clip whose channels the document holds (None: the character has no clips)."""
+    ch = character(doc, asset_id)
+    name = doc.assets[asset_id].properties.get(CLIP)
+    found = ch.clip_named(name) if isinstance(name, str) else None
+    return found
+
+
+def clip_channels_of(doc: Document, asset_id: str, name: str) -> dict[str, Channel]:
+    """A clip's channels by document channel id: the document's for the active clip, the
+    edited ones kept in ``clip_store`` for a clip left, else the file's."""
+    ch = character(doc, asset_id)
+    clip = ch.clip_named(name)
+    if clip is None:
+        raise KeyError(f"{asset_id!r} has no clip {name!r}")
+    active = active_clip(doc, asset_id)
+    if active is not None and active.name == name:
+        return dict(doc.channels_of(asset_id))
+    stored = (doc.assets[asset_id].properties.get(CLIP_STORE) or {}).get(name)
+    if isinstance(stored, dict):
+        return {f"{asset_id}/{rel}": Channel.from_dict(d) for rel, d in stored.items()}
+    return {f"{asset_id}/{rel}": c for rel, c in clip.channels.items()}
+
+
+def clip_duration(doc: Document, asset_id: str, name: str) -> tuple[float, float]:
+    """``(start, end)`` of a clip: the file's, or its keys' where the user keyed beyond them."""
+    ch = character(doc, asset_id)
+    clip = ch.clip_named(name)
+    if clip is None:
+        raise KeyError(f"{asset_id!r} has no clip {name!r}")
+    start, end = clip.start, clip.end
+    for c in clip_channels_of(doc, asset_id, name).values():
+        if c.keys:
+            start, end = min(start, c.keys[0].time), max(end, c.keys[-1].time)
+    return start, end
+
+
+def clip_range_command(doc: Document, start: float, end: float) -> Command | None:
+    """The document's frame range set to the frames covering ``start … end`` seconds (None:
+    it is that already)."""
+    first = int(np.floor(doc.time_to_frame(start) + 1e-6))
+    last = max(first, int(np.ceil(doc.time_to_frame(end) - 1e-6)))
+    commands: list[Command] = []
+    if doc.frame_range[0] != first:
+        commands.append(SetParameter(doc, "frame_start", first))
+    if doc.frame_range[1] != last:
+        commands.append(SetParameter(doc, "frame_end", last))
+    if first > doc.frame_range[1]:
+        commands.reverse()  # the end moves first, so that start never passes end
+    if not commands:
+        return None
+    return commands[0] if len(commands) == 1 else Macro("Frame range", commands)
+
+
+def set_clip_command(doc: Document, asset_id: str, name: str) -> Command:
+    """One undo step that makes the clip ``name`` the character's active one: the
+    document's channels of the character become that clip's, the channels of the clip
+    left are kept (edits included) in ``clip_store``, and the frame range fits the clip.
+
+    Raises KeyError for an unknown clip."""
+    ch = character(doc, asset_id)
+    if ch.clip_named(name) is None:
+        raise KeyError(f"{asset_id!r} has no clip {name!r}")
+    asset = doc.assets[asset_id]
+    current = active_clip(doc, asset_id)
+    new_channels = clip_channels_of(doc, asset_id, name)
+    store = {k: v for k, v in (asset.properties.get(CLIP_STORE) or {}).items() if k != name}
+    if current is not None and current.name != name:
+        store[current.name] = {cid[len(asset_id) + 1:]: c.to_dict() for cid, c in doc.channels_of(asset_id)}
+    old = dict(doc.channels_of(asset_id))
+    changes = {cid: (old.get(cid), new_channels.get(cid)) for cid in dict.fromkeys([*old, *new_channels])}
+    commands: list[Command] = [
+        SetChannels(f"Clip {name}", changes),
+        SetAssetProperty(doc, asset_id, CLIP, name),
+        SetAssetProperty(doc, asset_id, CLIP_STORE, store or None),
+    ]
+    start, end = clip_duration(doc, asset_id, name)
+    rng = clip_range_command(doc, start, end)
+    if rng is not None:
+        commands.append(rng)
+    return Macro(f"Play clip {name}", commands)
+
+
 # -------------------------------------------------------------------- evaluation
 def pose_skeleton(doc: Document, asset_id: str, time: float) -> Skeleton:
     """A posed copy of the character's skeleton at ``time`` (channel values clamped; a
-    pending, unkeyed pose at ``time`` is shown: see :mod:`qtanimator.document.pose`)."""
+    pending, unkeyed pose at ``time`` is shown: see :mod:`qtanimator.document.pose`).
+
+    A joint keyed as a quaternion is interpolated as one
+    (:func:`~qtanimator.core.quaternion_channels.quaternions_at`) and posed with the
+    equivalent Euler angles."""
     ch = character(doc, asset_id)
     skel = ch.skeleton.copy()
-    ids = _channel_ids(asset_id, skel.joint_keys())
     t = float(time)
     held = pending_values(doc, t)  # an unkeyed pose shown at this time (document.pose)
-    for i, cid in enumerate(ids):
+    channels = doc.channels
+
+    def value(cid: str) -> float | None:
         v = held.get(cid) if held else None
         if v is None:
-            channel = doc.channels.get(cid)
+            channel = channels.get(cid)
             if channel is None or not channel.keys:
-                continue
+                return None
             v = channel.evaluate(t)
-        if i < 3:
-            skel.root_translation[i] = v
+        return float(v)
+
+    for a, dof in enumerate(ROOT_DOFS):
+        v = value(channel_id(asset_id, "", dof))
+        if v is not None:
+            skel.root_translation[a] = v
+    quat_joints: list[int] = []
+    quats: list[FloatArray] = []
+    for j, (key, joint) in enumerate(zip(skel.joint_keys(), skel.joints)):
+        prefix = f"{asset_id}/{key}/"
+        if joint.quaternion:
+            cids = [prefix + d for d in QUAT_DOFS]
+            pending = [held.get(c) for c in cids] if held else [None] * 4
+            chans = [channels.get(c) for c in cids]
+            if any(p is not None for p in pending):
+                rest = ch.rest_quaternions()[j]
+                comps = [p if p is not None else (c.evaluate(t) if c is not None and c.keys else rest[slot])
+                         for p, c, slot in zip(pending, chans, (3, 0, 1, 2))]
+                q = np.array([comps[1], comps[2], comps[3], comps[0]], dtype=np.float64)
+                quat_joints.append(j)
+                quats.append(q / (np.linalg.norm(q) or 1.0))
+            elif any(c is not None and c.keys for c in chans):
+                quat_joints.append(j)
+                quats.append(quaternions_at(chans, ch.rest_quaternions()[j], [t])[0])
         else:
-            j, a = divmod(i - 3, 3)
-            skel.joints[j].dofs[a].value = v
+            for a, dof in enumerate(JOINT_DOFS):
+                v = value(prefix + dof)
+                if v is not None:
+                    joint.dofs[a].value = v
+        if joint.translates:
+            for a, dof in enumerate(TRANSLATE_DOFS):
+                v = value(prefix + dof)
+                if v is not None:
+                    joint.translation[a] = v
+        if joint.scales:
+            for a, dof in enumerate(SCALE_DOFS):
+                v = value(prefix + dof)
+                if v is not None:
+                    joint.scale[a] = v
+    if quat_joints:
+        q_all = np.array(quats)
+        orders = [skel.joints[j].rotation_order or skel.rotation_order for j in quat_joints]
+        for order in set(orders):
+            sel = [k for k, o in enumerate(orders) if o == order]
+            euler = quaternions_to_euler(q_all[sel], order)
+            for k, e in zip(sel, euler):
+                for a in range(3):
+                    skel.joints[quat_joints[k]].dofs[a].value = float(e[a])
     return skel
+
+
+def pose_channel_values(doc: Document, asset_id: str, time: float) -> dict[str, float]:
+    """Every channel of :func:`all_channel_ids` with the value the pose shown at ``time``
+    gives it (what "key the whole character" keys)."""
+    skel = pose_skeleton(doc, asset_id, time)
+    out = {channel_id(asset_id, "", d): float(v) for d, v in zip(ROOT_DOFS, skel.root_translation)}
+    for j, (key, joint) in enumerate(zip(skel.joint_keys(), skel.joints)):
+        prefix = f"{asset_id}/{key}/"
+        if joint.quaternion:
+            q = euler_to_quaternions(joint.pose, joint.rotation_order or skel.rotation_order)[0]
+            q = same_hemisphere(q, _shown_quaternion(doc, asset_id, j, time))
+            out.update({prefix + d: float(q[slot]) for d, slot in zip(QUAT_DOFS, (3, 0, 1, 2))})
+        else:
+            out.update({prefix + d: float(v) for d, v in zip(JOINT_DOFS, joint.pose)})
+        if joint.translates:
+            out.update({prefix + d: float(v) for d, v in zip(TRANSLATE_DOFS, joint.translation)})
+        if joint.scales:
+            out.update({prefix + d: float(v) for d, v in zip(SCALE_DOFS, joint.scale)})
+    return out
 
 
 def world_matrices(doc: Document, asset_id: str, time: float) -> FloatArray:
@@ -435,7 +789,7 @@ def skinned_mesh(doc: Document, asset_id: str, time: float) -> tuple[FloatArray,
     ch = character(doc, asset_id)
     if ch.skin is None:
         raise ValueError(f"3D character {asset_id!r} has no skin or mesh")
-    w = world_matrices(doc, asset_id, time)
+    w = ch.skinning_world(world_matrices(doc, asset_id, time))
     if ch.skin.normals is not None:
         return skin_positions_and_normals(ch.skin, w)
     positions = skin_positions(ch.skin, w)

@@ -14,22 +14,12 @@ the user (companion files that were picked up, approximations). The GUI's opener
 * ``.anim``: replaces a character's channels (:func:`load_anim_command`).
 * ``.obj``: an MIT mesh with its ``.skel`` (required) and ``.attach`` of the same stem.
 * ``.bvh``: skeleton (a rotation order per joint) and motion as channels with linear keys.
-* ``.glb`` / ``.gltf``: the first skinned mesh (all its skinned primitives), its skin's
-  joints as a DOF skeleton, and the first animation sampled onto DOF channels (below).
+* ``.glb`` / ``.gltf``: the whole character: every mesh, joints that move, turn and scale,
+  every animation as a clip (:mod:`qtanimator.document.gltf_character`).
 
 An import that brings a clip longer than the document's frame range also lengthens the range
 (in the same undo step), so the whole clip plays.
 
-glTF joints have a rest rotation, a translation and a scale each, and may hang below
-non-joint nodes; our joints are ``T(offset)·R(θ)`` with only the root translating. The
-mapping: every joint's glTF world matrix ``M = [A | t]`` is split (polar decomposition) into a
-rotation ``R`` and a stretch ``P = Rᵀ A``; the skeleton reproduces the rigid ``[R | t]`` and the
-stretch of the rest pose goes into the inverse bind matrix (``P · IBM``), so skinning
-``W · IBM`` is unchanged. This is exact as long as the joints' scales are not animated and
-only the root's translation is (both true of the Khronos samples up to rounding); otherwise
-the sampled pose is the nearest rigid one and the import says so in its notes. Rotations
-are sampled (key times plus the document's fps grid) into Euler angles unwrapped over time,
-held by channels with linear keys.
 """
 
 from __future__ import annotations
@@ -46,30 +36,26 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key, Tangent
-from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skeleton
-from qtanimator.core.skinning import Skin, SkinBinding
+from qtanimator.core.rotation import euler_from_matrices
 from qtanimator.document.character3d import (
     ASSET_KIND,
     BVH_POSITIONS,
+    CLIP,
     Character3D,
     _channel_ids,
     add_character3d_command,
     channel_ids,
     character,
+    clip_range_command,
     load_anim_command,
     load_bvh_character,
 )
 from qtanimator.document.commands import AddAsset, Command, Macro, SetParameter
 from qtanimator.document.document import Asset, Document
+from qtanimator.document.gltf_character import GLTF_ROTATION_ORDER, character_from_gltf
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.errors import FormatError
-from qtanimator.formats.gltf import (
-    CharacterExport,
-    GltfExportWarning,
-    GltfScene,
-    export_character_glb,
-    import_gltf,
-)
+from qtanimator.formats.gltf import CharacterExport, GltfExportWarning, export_character_glb, import_gltf
 from qtanimator.formats.skel import load_skel
 from qtanimator.formats.skin import load_skin
 
@@ -77,15 +63,11 @@ FloatArray = npt.NDArray[np.float64]
 
 SUFFIXES = (".skel", ".skin", ".anim", ".obj", ".bvh", ".glb", ".gltf")
 GLTF_SUFFIXES = (".glb", ".gltf")
-#: Euler order of the joints built from glTF (R = Rz·Ry·Rx, the balljoint order).
-GLTF_ROTATION_ORDER = "zyx"
-#: Most samples taken from one glTF animation.
-MAX_SAMPLES = 20_000
 
 __all__ = [
-    "GLTF_SUFFIXES", "GltfCharacter", "Import", "SUFFIXES", "anim_import", "bvh_import", "companions",
-    "export_gltf", "gltf_character", "gltf_import", "import_file", "load_gltf_character_asset", "obj_import",
-    "skel_import", "skin_import", "target_character",
+    "GLTF_ROTATION_ORDER", "GLTF_SUFFIXES", "Import", "SUFFIXES", "anim_import", "bvh_import", "companions",
+    "euler_from_matrices", "export_gltf", "gltf_import", "import_file", "load_gltf_character_asset",
+    "obj_import", "skel_import", "skin_import", "target_character",
 ]
 
 
@@ -272,6 +254,7 @@ def bvh_import(doc: Document, path: str | os.PathLike[str]) -> Import:
     aid = doc.unique_asset_id(_asset_base(p))
     ids = _channel_ids(aid, runtime.skeleton.joint_keys())
     channels = {cid: ch for cid, ch in zip(ids, chans) if ch is not None}
+    channels.update(runtime.translation_channels(aid))
     # The root-position convention detected (or chosen later in Properties) is saved with
     # the asset; the notes say which one was used and what was ignored.
     asset = Asset(aid, ASSET_KIND, str(p.resolve()), {BVH_POSITIONS: runtime.positions})
@@ -287,251 +270,50 @@ def _asset_base(p: Path) -> str:
 
 
 # --------------------------------------------------------------------------- glTF
-@dataclass
-class GltfCharacter:
-    """What a glTF file maps to: the character, its sampled channels (``.anim`` layout,
-    None where a DOF does not move) and notes on approximations."""
-
-    character: Character3D
-    channels: list[Channel | None]
-    times: FloatArray
-    mesh: int | None
-    skin: int
-    notes: list[str]
-
-
-def _polar(m: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """(…, 3, 3) → rotation R and stretch P with m = R · P."""
-    u, _s, vt = np.linalg.svd(m)
-    d = np.sign(np.linalg.det(u @ vt))
-    u = u.copy()
-    u[..., :, 2] *= d[..., None]
-    r = u @ vt
-    return r, np.swapaxes(r, -1, -2) @ m
-
-
-def euler_from_matrices(r: FloatArray, order: str) -> FloatArray:
-    """(N, 3, 3) rotations → (N, 3) angles (x, y, z) with ``r = R_a·R_b·R_c`` for ``order`` "abc"."""
-    a, b, c = ("xyz".index(ch) for ch in order)
-    # r = Ra·Rb·Rc: the standard Tait–Bryan extraction, signed by the order's parity.
-    sign = 1.0 if (b - a) % 3 == 1 else -1.0
-    sb = np.clip(sign * r[:, a, c], -1.0, 1.0)
-    angle_b = np.arcsin(sb)
-    angle_a = np.arctan2(-sign * r[:, b, c], r[:, c, c])
-    angle_c = np.arctan2(-sign * r[:, a, b], r[:, a, a])
-    lock = np.abs(sb) > 1.0 - 1e-12
-    if np.any(lock):
-        # Gimbal lock: put the whole turn on the first axis.
-        angle_c = np.where(lock, 0.0, angle_c)
-        angle_a = np.where(lock, np.arctan2(sign * r[:, c, b], r[:, b, b]), angle_a)
-    out = np.zeros((len(r), 3))
-    out[:, a], out[:, b], out[:, c] = angle_a, angle_b, angle_c
-    return out
-
-
-def _skinned_mesh_index(scene: GltfScene) -> int | None:
-    for mi, mesh in enumerate(scene.meshes):
-        node = scene.mesh_node(mi)
-        if node is None or scene.nodes[node].skin is None:
-            continue
-        if any(prim.joints is not None and prim.weights is not None for prim in mesh.primitives):
-            return mi
-    return None
-
-
-def _gltf_skin(scene: GltfScene, mesh: int) -> Skin:
-    """All skinned primitives of ``mesh`` as one skin (joint indices of the glTF skin)."""
-    parts = [scene.to_skin(mesh, k) for k, prim in enumerate(scene.meshes[mesh].primitives)
-             if prim.joints is not None and prim.weights is not None]
-    if len(parts) == 1:
-        return parts[0]
-    offsets = np.cumsum([0] + [s.num_vertices for s in parts])
-    nv = int(offsets[-1])
-    binding = SkinBinding(np.concatenate([s.binding.vertex + o for s, o in zip(parts, offsets)]),
-                          np.concatenate([s.binding.joint for s in parts]),
-                          np.concatenate([s.binding.weight for s in parts]), nv, parts[0].binding.num_joints)
-    normals = (np.concatenate([s.normals for s in parts]) if all(s.normals is not None for s in parts)
-               else None)
-    return Skin(np.concatenate([s.positions for s in parts]),
-                np.concatenate([s.triangles + o for s, o in zip(parts, offsets)]), binding,
-                parts[0].inverse_bind_matrices, normals=normals)
-
-
-def _joint_name(scene: GltfScene, node: int, k: int) -> str:
-    name = scene.nodes[node].name.strip()
-    return name or f"joint{k}"
-
-
-def gltf_character(scene: GltfScene, fps: float = 30.0, *, sample: bool = True,
-                   mesh: int | None = None) -> GltfCharacter:
-    """Map a glTF scene to a character (see the module doc). ``mesh`` None picks the first
-    skinned mesh; a file with skins but no skinned mesh gives a skeleton alone."""
-    path = scene.path
-    if mesh is None:
-        mesh = _skinned_mesh_index(scene)
-    if mesh is not None:
-        node = scene.mesh_node(mesh)
-        if node is None or scene.nodes[node].skin is None:
-            raise FormatError(f"mesh {mesh} of the glTF file is not skinned.", path)
-        skin_index = int(scene.nodes[node].skin or 0)
-    elif scene.skins:
-        skin_index = 0
-    else:
-        raise FormatError("the glTF file has no skin (no skeleton), so it cannot be imported as a 3D "
-                          "character.", path)
-    gskin = scene.skins[skin_index]
-    jnodes = list(gskin.joints)
-    if not jnodes:
-        raise FormatError("the glTF skin has no joints.", path)
-    in_skin = {n: k for k, n in enumerate(jnodes)}
-    if len(in_skin) != len(jnodes):
-        raise FormatError("the glTF skin lists a joint twice.", path)
-
-    # The joint forest: each joint's parent is its nearest ancestor that is a joint.
-    parent_of: dict[int, int | None] = {}
-    for n in jnodes:
-        a = scene.nodes[n].parent
-        while a is not None and a not in in_skin:
-            a = scene.nodes[a].parent
-        parent_of[n] = a
-    children: dict[int | None, list[int]] = {}
-    for n in jnodes:
-        children.setdefault(parent_of[n], []).append(n)
-    roots = children.get(None, [])
-    synthetic = len(roots) != 1
-    order: list[int] = []  # glTF node per skeleton joint (-1 = synthetic root)
-    parents: list[int | None] = []
-    if synthetic:
-        order.append(-1)
-        parents.append(None)
-    stack: list[tuple[int, int | None]] = [(r, 0 if synthetic else None) for r in reversed(roots)]
-    while stack:
-        n, p = stack.pop()
-        order.append(n)
-        parents.append(p)
-        idx = len(order) - 1
-        stack.extend((c, idx) for c in reversed(children.get(n, [])))
-    nj = len(order)
-    perm = np.array([order.index(n) for n in jnodes], dtype=np.intp)
-
-    def rigid_locals(world_nodes: FloatArray) -> tuple[FloatArray, FloatArray]:
-        """(T, N, 4, 4) node worlds → (T, J, 4, 4) rigid joint locals and (T, J, 3, 3) stretches."""
-        t = world_nodes.shape[0]
-        w = np.tile(np.eye(4), (t, nj, 1, 1))
-        stretch = np.tile(np.eye(3), (t, nj, 1, 1))
-        real = [i for i, n in enumerate(order) if n >= 0]
-        nodes_idx = [order[i] for i in real]
-        r, pmat = _polar(world_nodes[:, nodes_idx, :3, :3])
-        w[:, real, :3, :3] = r
-        w[:, real, :3, 3] = world_nodes[:, nodes_idx, :3, 3]
-        stretch[:, real] = pmat
-        local = w.copy()
-        for i, p in enumerate(parents):
-            if p is not None:
-                local[:, i] = np.linalg.inv(w[:, p]) @ w[:, i]
-        return local, stretch
-
-    rest_local, rest_stretch = rigid_locals(scene.world_matrices(None)[None])
-    rest_local, rest_stretch = rest_local[0], rest_stretch[0]
-    joints: list[Joint] = []
-    names = [("root" if n < 0 else _joint_name(scene, n, k)) for k, n in enumerate(order)]
-    rest_angles = euler_from_matrices(rest_local[:, :3, :3], GLTF_ROTATION_ORDER)
-    for i in range(nj):
-        offset = np.zeros(3) if parents[i] is None else rest_local[i, :3, 3].copy()
-        joints.append(Joint(names[i], parents[i], offset, boxmin=np.array(DEFAULT_BOXMIN),
-                            boxmax=np.array(DEFAULT_BOXMAX), rotation_order=GLTF_ROTATION_ORDER))
-    skeleton = Skeleton(joints, rotation_order=GLTF_ROTATION_ORDER,
-                        name=Path(path).stem if path else "", dialect="gltf")
-    skeleton.root_translation = rest_local[0, :3, 3].copy()
-    for i in range(nj):
-        for a in range(3):
-            skeleton.set_dof(i, a, float(rest_angles[i, a]))
-
-    notes: list[str] = []
-    skin: Skin | None = None
-    if mesh is not None:
-        gs = _gltf_skin(scene, mesh)
-        ibm = np.tile(np.eye(4), (nj, 1, 1))
-        stretch4 = np.tile(np.eye(4), (len(jnodes), 1, 1))
-        stretch4[:, :3, :3] = rest_stretch[perm]
-        ibm[perm] = stretch4 @ gs.inverse_bind_matrices[: len(jnodes)]
-        binding = SkinBinding(gs.binding.vertex, perm[gs.binding.joint], gs.binding.weight, gs.num_vertices, nj)
-        skin = Skin(gs.positions, gs.triangles, binding, ibm, normals=gs.normals, texcoords=gs.texcoords)
-    else:
-        notes.append("The file has no skinned mesh: only its skeleton was imported.")
-    if synthetic:
-        notes.append(f"The skin has {len(roots)} root joints; they hang below an added joint 'root' "
-                     "and only its translation is animated.")
-
-    channels: list[Channel | None] = [None] * (3 + 3 * nj)
-    times = np.zeros(0)
-    if sample and scene.animations:
-        anim = scene.animations[0]
-        times = _gltf_sample_times(anim.samplers, anim.start, anim.end, fps)
-        worlds = np.stack([scene.world_matrices(float(t), 0) for t in times])
-        local, stretch = rigid_locals(worlds)
-        angles = euler_from_matrices(local[:, :, :3, :3].reshape(-1, 3, 3), GLTF_ROTATION_ORDER)
-        angles = np.unwrap(angles.reshape(len(times), nj, 3), axis=0)
-        # Keep the sampled angles on the same turn as the rest pose.
-        angles -= 2 * np.pi * np.round((angles[0] - rest_angles) / (2 * np.pi))[None]
-        values = np.concatenate([local[:, 0, :3, 3], angles.reshape(len(times), -1)], axis=1)
-        rest = np.concatenate([skeleton.root_translation, rest_angles.reshape(-1)])
-        tl = times.tolist()
-        for c in range(values.shape[1]):
-            col = values[:, c]
-            if np.max(np.abs(col - rest[c])) > 1e-9:
-                channels[c] = _linear_channel(tl, col.tolist())
-        moved = np.abs(local[:, 1:, :3, 3] - rest_local[None, 1:, :3, 3]).max() if nj > 1 else 0.0
-        size = float(np.ptp(rest_local[:, :3, 3], axis=0).max()) or 1.0
-        if moved > 1e-4 * size:
-            notes.append(f"Joints below the root move (up to {moved:.3g}) in the animation; our joints only "
-                         "rotate, so that motion is left out.")
-        if np.abs(stretch - rest_stretch[None]).max() > 1e-4:
-            notes.append("The animation scales joints; scaling is left out (the pose is the nearest rigid one).")
-        notes.append(f"Animation {anim.name or 0!s} sampled onto joint channels at {len(times)} times "
-                     f"with linear keys ({anim.start:g}–{anim.end:g} s).")
-        if len(scene.animations) > 1:
-            notes.append(f"Only the first of {len(scene.animations)} animations was imported.")
-    ch = Character3D(skeleton, skin, None, None, False)
-    return GltfCharacter(ch, channels, times, mesh, skin_index, notes)
-
-
-def _gltf_sample_times(samplers: Sequence[Any], start: float, end: float, fps: float) -> FloatArray:
-    keys = [np.asarray(s.times, dtype=np.float64) for s in samplers]
-    n = int(math.floor((end - start) * fps + 1e-9)) + 1 if end > start else 1
-    grid = start + np.arange(min(n, MAX_SAMPLES), dtype=np.float64) / fps
-    allt = np.concatenate([grid, *keys, [start, end]])
-    allt = np.unique(allt[(allt >= start) & (allt <= end)])
-    keep = np.concatenate([[True], np.diff(allt) > 1e-6])
-    times: FloatArray = allt[keep][:MAX_SAMPLES]
-    return times
-
-
 def load_gltf_character_asset(asset: Asset) -> Character3D:
     """The runtime of a character whose source is a ``.glb`` / ``.gltf`` (a project being opened)."""
     if not asset.source:
         raise FormatError(f"3D character {asset.id!r} has no source file.")
-    mesh = asset.properties.get("gltf_mesh")
-    scene = import_gltf(asset.source)
-    if mesh is not None and not (isinstance(mesh, int) and 0 <= mesh < len(scene.meshes)):
-        raise FormatError(f"3D character {asset.id!r}: the glTF file has no mesh {mesh!r}.", asset.source)
-    return gltf_character(scene, sample=False, mesh=mesh).character
+    return character_from_gltf(import_gltf(asset.source), asset.source).character
+
+
+def _animated_elsewhere(doc: Document) -> bool:
+    """Whether the document has keys on any channel (its range is someone's choice)."""
+    return any(c.keys for c in doc.channels.values())
 
 
 def gltf_import(doc: Document, path: str | os.PathLike[str]) -> Import:
-    """A ``.glb`` / ``.gltf``: first skinned mesh, its skeleton and first animation."""
+    """A ``.glb`` / ``.gltf``: the whole character (every mesh, every animation as a clip;
+    see :mod:`qtanimator.document.gltf_character`), the first clip active. The frame range
+    fits that clip, or grows to show it when the document already has keys."""
     p = Path(path)
     scene = import_gltf(p)
-    g = gltf_character(scene, doc.fps)
+    mapping = character_from_gltf(scene, p)
+    ch = mapping.character
     aid = doc.unique_asset_id(_asset_base(p))
-    ids = _channel_ids(aid, g.character.skeleton.joint_keys())
-    channels = {cid: ch for cid, ch in zip(ids, g.channels) if ch is not None}
     props: dict[str, Any] = {}
-    if g.mesh is not None:
-        props["gltf_mesh"] = g.mesh
+    channels: dict[str, Channel] = {}
+    if ch.clips:
+        first = ch.clips[0]
+        props[CLIP] = first.name
+        channels = {f"{aid}/{rel}": c for rel, c in first.channels.items()}
     asset = Asset(aid, ASSET_KIND, str(p.resolve()), props)
-    add = AddAsset(asset, g.character, channels, text=f"Add 3D character {aid}")
-    return _with_range(doc, add.text, add, _channels_end(list(channels.values())), aid, list(g.notes))
+    add = AddAsset(asset, ch, channels, text=f"Add 3D character {aid}")
+    nv = ch.skin.num_vertices if ch.skin is not None else 0
+    notes = [f"{len(ch.parts)} meshes ({nv} vertices), {len(ch.skeleton.joints)} joints."]
+    if ch.clips:
+        listed = ", ".join(f"{c.name} ({c.end - c.start:.3g} s)" for c in ch.clips)
+        notes.append(f"{len(ch.clips)} clips: {listed}; pick one in Properties or the 3D toolbar.")
+    notes += mapping.notes
+    if not ch.clips:
+        return Import(add, aid, notes)
+    if _animated_elsewhere(doc):
+        return _with_range(doc, add.text, add, ch.clips[0].end, aid, notes)
+    rng = clip_range_command(doc, ch.clips[0].start, ch.clips[0].end)
+    if rng is None:
+        return Import(add, aid, notes)
+    notes.append("Frame range set to the clip.")
+    return Import(Macro(add.text, [add, rng]), aid, notes)
 
 
 # --------------------------------------------------------------------------- any

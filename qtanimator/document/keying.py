@@ -305,7 +305,7 @@ def animatable_channel_ids(doc: Document, asset_id: str) -> list[str]:
                 *(character2d.angle_channel_id(asset_id, j.name) for j in ch.joints)]
     elif asset.kind == character3d.ASSET_KIND:
         try:
-            more = character3d.channel_ids(doc, asset_id)
+            more = character3d.all_channel_ids(doc, asset_id)
         except KeyError:
             return ids
     else:

@@ -48,7 +48,7 @@ import numpy as np
 
 from qtanimator.core.channel import Key
 from qtanimator.document.commands import Command, SetKeys
-from qtanimator.document.document import Document, DocumentChange
+from qtanimator.document.document import Document, DocumentChange, channel_id
 
 AUTOKEY_VIEW_STATE = "animation.autokey"
 #: The pseudo parameter a change of the pending pose announces (not a real parameter).
@@ -249,12 +249,7 @@ def shown_values_2d(doc: Document, asset_id: str, time: float,
 
 def shown_values_3d(doc: Document, asset_id: str, time: float) -> dict[str, float]:
     """Every DOF channel value of a 3D character as shown at ``time`` (clamped)."""
-    c3d = _c3d()
-    skel = c3d.pose_skeleton(doc, asset_id, time)
-    ids = c3d.channel_ids(doc, asset_id)
-    values = [*np.asarray(skel.root_translation, dtype=float).tolist(),
-              *np.asarray(skel.dof_values(), dtype=float).reshape(-1).tolist()]
-    return {cid: float(v) for cid, v in zip(ids, values)}
+    return _c3d().pose_channel_values(doc, asset_id, time)
 
 
 def shown_values(doc: Document, asset_id: str, time: float, cids: Iterable[str] | None = None) -> dict[str, float]:
@@ -280,9 +275,10 @@ def joint_channels(doc: Document, asset_id: str, joint: str) -> list[str]:
         return [c2d.angle_channel_id(asset_id, joint)]
     if kind == _c3d().ASSET_KIND:
         c3d = _c3d()
-        keys = c3d.character(doc, asset_id).joint_keys
+        skel = c3d.character(doc, asset_id).skeleton
+        keys = skel.joint_keys()
         index = keys.index(joint) if joint else 0
-        ids = [c3d.dof_channel_id(doc, asset_id, index, a) for a in c3d.JOINT_DOFS]
+        ids = [channel_id(asset_id, keys[index], d) for d in c3d.joint_channel_names(skel.joints[index])]
         if index == 0:
             ids += [c3d.dof_channel_id(doc, asset_id, None, a) for a in c3d.ROOT_DOFS]
         return ids
@@ -299,7 +295,7 @@ def character_channels(doc: Document, asset_id: str) -> list[str]:
         ids = [c2d.angle_channel_id(asset_id, j.name) for j in ch.joints if not j.is_dynamic]
         return ids + list(c2d.position_channel_ids(asset_id))
     if kind == _c3d().ASSET_KIND:
-        return list(_c3d().channel_ids(doc, asset_id))
+        return list(_c3d().all_channel_ids(doc, asset_id))
     raise KeyError(f"{asset_id} is not a character")
 
 
@@ -308,7 +304,10 @@ def key_channels_command(doc: Document, asset_id: str, cids: Iterable[str], time
     """Key the shown values of ``cids`` at ``time`` (one undo step)."""
     cids = list(cids)
     shown = shown_values(doc, asset_id, time, cids)
-    keys = {cid: Key(float(time), shown[cid]) for cid in cids}
+    if _kind(doc, asset_id) == _c3d().ASSET_KIND:
+        keys = {cid: _c3d().new_key(cid, time, shown[cid]) for cid in cids}
+    else:
+        keys = {cid: Key(float(time), shown[cid]) for cid in cids}
     return SetKeys(doc, keys, text=text)
 
 
@@ -410,12 +409,13 @@ def copy_pose(doc: Document, asset_id: str, joint: str, time: float) -> PoseClip
             values[name] = {"angle": shown[c2d.angle_channel_id(asset_id, name)]}
     else:
         c3d = _c3d()
-        shown = shown_values_3d(doc, asset_id, time)
-        keys = c3d.character(doc, asset_id).joint_keys
+        # Euler angles whatever the joint is keyed in (a quaternion joint's are converted).
+        posed = c3d.pose_skeleton(doc, asset_id, time)
+        keys = posed.joint_keys()
         chosen = [joint] if joint else list(keys)
         for key in chosen:
-            index = keys.index(key)
-            values[key] = {a: shown[c3d.dof_channel_id(doc, asset_id, index, a)] for a in c3d.JOINT_DOFS}
+            pose = posed.joints[keys.index(key)].pose
+            values[key] = {a: float(v) for a, v in zip(c3d.JOINT_DOFS, pose)}
     return PoseClip(kind, asset_id, values)
 
 
@@ -486,7 +486,8 @@ def _key_of(keys: list[str], name: str, rank: int) -> str | None:
     return None
 
 
-def paste_values(doc: Document, clip: PoseClip, asset_id: str, mirrored: bool = False) -> dict[str, float]:
+def paste_values(doc: Document, clip: PoseClip, asset_id: str, mirrored: bool = False,
+                 time: float | None = None) -> dict[str, float]:
     """The channel values pasting ``clip`` onto ``asset_id`` sets (joints the character
     does not have are left out). Mirrored: each joint's values go to its mirror-named
     joint (itself when it has no side), mirrored by :func:`mirrored_value`."""
@@ -514,6 +515,7 @@ def paste_values(doc: Document, clip: PoseClip, asset_id: str, mirrored: bool = 
     if clip.source in doc.assets and doc.assets[clip.source].kind == kind and clip.source in doc.runtime:
         source_keys = list(c3d.character(doc, clip.source).joint_keys)
     lateral = lateral_axis_3d(runtime.skeleton)
+    dof_values: dict[tuple[int | None, str | int], float] = {}
     for key, dofs in clip.values.items():
         found: str | None
         if mirrored:
@@ -524,22 +526,24 @@ def paste_values(doc: Document, clip: PoseClip, asset_id: str, mirrored: bool = 
         if found is None:
             continue
         index = keys.index(found)
-        skel_joint = runtime.skeleton.joints[index]
         for dof, value in dofs.items():
             v = mirrored_value(kind, dof, float(value), lateral=lateral) if mirrored else float(value)
-            v = skel_joint.dofs["xyz".index(dof[-1])].clamp(v)
-            out[c3d.dof_channel_id(doc, asset_id, index, dof)] = v
-    return out
+            dof_values[(index, dof)] = v
+    # Clamped to the limits; a joint keyed as a quaternion gets its four components.
+    return c3d.dof_values(doc, asset_id, dof_values, time)
 
 
 def paste_pose_command(doc: Document, clip: PoseClip, asset_id: str, time: float,
                        mirrored: bool = False) -> Command | None:
     """Ctrl+V / Ctrl+Shift+V: key the clip's values at ``time`` (one undo step); None
     when nothing of the clip fits the character."""
-    values = paste_values(doc, clip, asset_id, mirrored)
+    values = paste_values(doc, clip, asset_id, mirrored, time)
     if not values:
         return None
-    keys = {cid: Key(float(time), v) for cid, v in values.items()}
+    if _kind(doc, asset_id) == _c3d().ASSET_KIND:
+        keys = {cid: _c3d().new_key(cid, time, v) for cid, v in values.items()}
+    else:
+        keys = {cid: Key(float(time), v) for cid, v in values.items()}
     return SetKeys(doc, keys, text="Paste Pose Mirrored" if mirrored else "Paste Pose")
 
 

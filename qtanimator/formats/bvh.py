@@ -313,18 +313,21 @@ class BvhClip:
                 world[:, ji] = world[:, joint.parent] @ local
         return world
 
-    def to_skeleton(self, positions: str | None = None) -> tuple[Skeleton, list[Channel | None]]:
-        """A :class:`~qtanimator.core.skeleton.Skeleton` (one rotation order per joint) and
+    def to_skeleton(self, positions: str | None = None
+                    ) -> tuple[Skeleton, list[Channel | None], dict[int, list[Channel | None]]]:
+        """A :class:`~qtanimator.core.skeleton.Skeleton` (one rotation order per joint),
         channels in the ``.anim`` layout of :mod:`qtanimator.core.clip` (root translation
-        x, y, z, then x, y, z rotation per joint, radians) that pose it like this clip under
-        the position convention ``positions`` (default :attr:`positions`).
+        x, y, z, then x, y, z rotation per joint, radians) and, per joint below the root that
+        moves, its x, y, z translation channels (None where the file has no channel), that
+        pose it like this clip under the position convention ``positions`` (default
+        :attr:`positions`).
 
-        The root's position channels become the root translation (absolute: the root's
-        OFFSET is 0 on those axes, so the channel replaces it). A joint below the root whose
-        position channels stay still (within :data:`STILL_TOLERANCE` of the size; Blender
-        writes them equal to the OFFSET) gets that translation as its offset; joints without a
-        channel get None. Raises ValueError for what a skeleton cannot hold: a joint below
-        the root that moves, or several roots.
+        The root's position channels become the root translation. A joint below the root
+        whose position channels stay still (within :data:`STILL_TOLERANCE` of the size;
+        Blender writes them equal to the OFFSET) gets that translation as its offset; one
+        that moves gets translation channels (:attr:`Joint.translates`) holding the file's
+        numbers, added to its offset. Absolute positions replace the OFFSET on their axes, so
+        the offset is 0 there. Raises ValueError for several roots.
         """
         convention = _convention(positions or self.positions)
         roots = [i for i, j in enumerate(self.joints) if j.parent is None]
@@ -332,33 +335,34 @@ class BvhClip:
             raise ValueError(f"a skeleton has one root; this BVH has {len(roots)}")
         joints: list[Joint] = []
         channels: list[Channel | None] = [None] * (3 + 3 * len(self.joints))
+        moving: dict[int, list[Channel | None]] = {}
         by_name = self.channels
         values = self.channel_values_radians() if self.frame_count else np.zeros((1, self.channel_count))
         tolerance = STILL_TOLERANCE * self.size()
         for ji, j in enumerate(self.joints):
             offset = j.offset.copy()
             moves = any(c.endswith("position") for c in j.channels)
-            if ji == roots[0]:
-                if moves and convention == "absolute":
-                    for c in j.channels:
-                        if c.endswith("position"):
-                            offset["xyz".index(c[0].lower())] = 0.0
-            elif moves:
+            translates = False
+            if moves and ji != roots[0]:
                 trans = self.local_translations(values, ji, convention)
-                drift = float(np.abs(trans - trans[0]).max())
-                if drift > tolerance:
-                    raise ValueError(f"joint '{j.name}' moves (its position channels change by up to {drift:.6g} "
-                                     "file units); qtanimator's 3D joints below the root only turn")
-                offset = trans[0].copy()
+                translates = float(np.abs(trans - trans[0]).max()) > tolerance
+                if not translates:
+                    offset = trans[0].copy()
+            if moves and (ji == roots[0] or translates) and convention == "absolute":
+                for c in j.channels:
+                    if c.endswith("position"):
+                        offset["xyz".index(c[0].lower())] = 0.0
             order = j.rotation_order
             order += "".join(a for a in "xyz" if a not in order)
             joints.append(Joint(j.name, j.parent, offset, rotation_order=order,
-                                boxmin=np.zeros(3), boxmax=np.zeros(3)))
+                                boxmin=np.zeros(3), boxmax=np.zeros(3), translates=translates))
             for c in j.channels:
                 axis = "xyz".index(c[0].lower())
                 if c.endswith("position"):
                     if ji == roots[0]:
                         channels[axis] = by_name[f"{j.key}/{c}"]
+                    elif translates:
+                        moving.setdefault(ji, [None, None, None])[axis] = by_name[f"{j.key}/{c}"]
                 else:
                     channels[3 + 3 * ji + axis] = by_name[f"{j.key}/{c}"]
         skeleton = Skeleton(joints, rotation_order="zyx", name=Path(self.path).stem if self.path else "")
@@ -369,9 +373,11 @@ class BvhClip:
                 if c.endswith("position"):
                     if ji == roots[0]:
                         skeleton.root_translation[axis] = first[col]
+                    elif ji in moving:
+                        skeleton.joints[ji].translation[axis] = first[col]
                 else:
                     skeleton.set_dof(ji, axis, first[col])
-        return skeleton, channels
+        return skeleton, channels, moving
 
     def summary(self) -> dict[str, Any]:
         roots = [j.name for j in self.joints if j.parent is None]

@@ -41,6 +41,9 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.channel import Channel
+from qtanimator.core.rotation import normalize as _normalize
+from qtanimator.core.rotation import quaternion_multiply, quaternion_to_matrix, trs_matrix
+from qtanimator.core.rotation import slerp as _slerp
 from qtanimator.core.skeleton import ROTATION_ORDERS, Skeleton
 from qtanimator.core.skinning import Skin, SkinBinding
 from qtanimator.formats._tokens import read_bytes
@@ -87,69 +90,6 @@ WEIGHT_SUM_TOLERANCE = 1e-6
 
 class GltfExportWarning(UserWarning):
     """An export had to change the character (e.g. dropping influences beyond four)."""
-
-
-# --------------------------------------------------------------------------- math
-def quaternion_to_matrix(q: npt.ArrayLike) -> FloatArray:
-    """(…, 4) unit quaternions ``(x, y, z, w)`` → (…, 3, 3) rotation matrices."""
-    a = np.asarray(q, dtype=np.float64)
-    x, y, z, w = a[..., 0], a[..., 1], a[..., 2], a[..., 3]
-    out = np.empty(a.shape[:-1] + (3, 3))
-    out[..., 0, 0] = 1 - 2 * (y * y + z * z)
-    out[..., 0, 1] = 2 * (x * y - z * w)
-    out[..., 0, 2] = 2 * (x * z + y * w)
-    out[..., 1, 0] = 2 * (x * y + z * w)
-    out[..., 1, 1] = 1 - 2 * (x * x + z * z)
-    out[..., 1, 2] = 2 * (y * z - x * w)
-    out[..., 2, 0] = 2 * (x * z - y * w)
-    out[..., 2, 1] = 2 * (y * z + x * w)
-    out[..., 2, 2] = 1 - 2 * (x * x + y * y)
-    return out
-
-
-def quaternion_multiply(a: npt.ArrayLike, b: npt.ArrayLike) -> FloatArray:
-    """Hamilton product of (…, 4) ``(x, y, z, w)`` quaternions: the rotation ``a`` after ``b``."""
-    p = np.asarray(a, dtype=np.float64)
-    q = np.asarray(b, dtype=np.float64)
-    x1, y1, z1, w1 = p[..., 0], p[..., 1], p[..., 2], p[..., 3]
-    x2, y2, z2, w2 = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
-    return np.stack([
-        w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-        w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-        w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-        w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-    ], axis=-1)
-
-
-def trs_matrix(translation: npt.ArrayLike, rotation: npt.ArrayLike, scale: npt.ArrayLike) -> FloatArray:
-    """(…, 4, 4) ``T · R · S`` from (…, 3), (…, 4) and (…, 3) arrays."""
-    t = np.asarray(translation, dtype=np.float64)
-    r = quaternion_to_matrix(rotation)
-    s = np.asarray(scale, dtype=np.float64)
-    out = np.zeros(t.shape[:-1] + (4, 4))
-    out[..., :3, :3] = r * s[..., None, :]
-    out[..., :3, 3] = t
-    out[..., 3, 3] = 1.0
-    return out
-
-
-def _normalize(q: FloatArray) -> FloatArray:
-    n = np.linalg.norm(q, axis=-1, keepdims=True)
-    result: FloatArray = q / np.where(n > 0, n, 1.0)
-    return result
-
-
-def _slerp(a: FloatArray, b: FloatArray, u: float) -> FloatArray:
-    """Shortest-path spherical interpolation of unit quaternions (glTF 2.0 appendix)."""
-    d = float(np.dot(a, b))
-    if d < 0.0:
-        b, d = -b, -d
-    if d > 0.9995:
-        return _normalize(a + u * (b - a))
-    theta = math.acos(min(d, 1.0))
-    s = math.sin(theta)
-    result: FloatArray = (math.sin((1 - u) * theta) * a + math.sin(u * theta) * b) / s
-    return result
 
 
 # --------------------------------------------------------------------------- scene model

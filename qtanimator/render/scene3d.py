@@ -106,6 +106,8 @@ def skin_draw(doc: Any, asset_id: str, world: np.ndarray) -> SkinDraw | None:
     if skin is None:
         return None
     arrays = gpu_skin_arrays(skin)
+    if isinstance(runtime, character3d.Character3D):
+        world = runtime.skinning_world(world)
     faceted = bool(getattr(runtime, "faceted", False)) or arrays["faceted"]
     inv = arrays["inverse_bind"]
     n = min(len(world), len(inv))

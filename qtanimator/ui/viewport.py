@@ -739,7 +739,7 @@ class Viewport3D(QWidget):
         if self._drag.get("autokey", True):
             gesture.update(character3d.set_dofs_command(doc, asset_id, values, time))
         else:
-            gesture.update(PosePreview(doc, character3d.dof_values(doc, asset_id, values), time, "IK drag"))
+            gesture.update(PosePreview(doc, character3d.dof_values(doc, asset_id, values, time), time, "IK drag"))
 
     # ------------------------------------------------------ set key, copy, paste
     def _say(self, text: str) -> None:

@@ -9,14 +9,14 @@ import pytest
 
 from qtanimator.core.skeleton import rotation_matrices
 from qtanimator.document import Document, UndoStack, open_document, save_document
-from qtanimator.document.character3d import ASSET_KIND, _channel_ids, character, skinned_mesh, world_matrices
+from qtanimator.document.character3d import ASSET_KIND, character, skinned_mesh, world_matrices
 from qtanimator.document.commands import AddAsset
 from qtanimator.document.document import Asset
+from qtanimator.document.gltf_character import character_from_gltf
 from qtanimator.document.import3d import (
     companions,
     euler_from_matrices,
     export_gltf,
-    gltf_character,
     import_file,
 )
 from qtanimator.formats import FormatError
@@ -148,16 +148,15 @@ def test_gltf_import_follows_the_files_animation(shared_data, tmp_path, name):
     doc, stack, result, before = _imported(path)
     aid = result.asset_id
     scene = import_gltf(path)
-    mesh = doc.assets[aid].properties["gltf_mesh"]
     anim = scene.animations[0]
-    # Only CesiumMan moves joints below the root (by 0.3 % of its size): the notes say so.
-    tolerance = 5e-3 if name == "CesiumMan.glb" else 1e-5
+    (part,) = character(doc, aid).parts
+    # Joints that move (CesiumMan's hips), slerp between keys: exact, not nearly.
     for t in np.linspace(anim.start, anim.end, 7):
-        ref = scene.skinned_positions(mesh, t)
+        ref = scene.skinned_positions(part.mesh, t)
         ours, _normals = skinned_mesh(doc, aid, t)
         size = np.linalg.norm(np.ptp(ref, axis=0))
-        assert np.abs(ours - ref).max() <= tolerance * size
-    assert any("sampled" in n for n in result.notes)
+        assert np.abs(ours - ref).max() <= 1e-9 * size
+    assert any("1 clips" in n for n in result.notes)
     project = tmp_path / "g.qtanim"
     save_document(doc, project)
     again = open_document(project)
@@ -170,12 +169,11 @@ def test_gltf_import_follows_the_files_animation(shared_data, tmp_path, name):
 
 def test_gltf_mapping_in_rest_pose_is_exact(shared_data):
     scene = import_gltf(shared_data / "gltf" / "CesiumMan.glb")
-    g = gltf_character(scene, sample=False)
-    ch = g.character
+    ch = character_from_gltf(scene).character
     from qtanimator.core.skinning import skin_positions
 
-    ours = skin_positions(ch.skin, ch.skeleton.world_matrices())
-    assert np.allclose(ours, scene.skinned_positions(g.mesh, None), atol=1e-9)
+    ours = skin_positions(ch.skin, ch.skinning_world(ch.skeleton.world_matrices()))
+    assert np.allclose(ours, scene.skinned_positions(ch.parts[0].mesh, None), atol=1e-9)
 
 
 def test_bad_files_are_format_errors_and_change_nothing(tmp_path):
@@ -248,15 +246,18 @@ def test_gltf_skin_with_two_root_joints_and_a_scaled_parent():
     scene = GltfScene(nodes=nodes, meshes=[GltfMesh([prim])], skins=[GltfSkin([1, 2], ibm)],
                       animations=[anim], roots=[0, 3])
     assert np.allclose(quaternion_to_matrix(q[1])[:3, :3] @ [0, 1, 0], [0, 0, 1])
-    g = gltf_character(scene, fps=10)
-    skel = g.character.skeleton
-    assert [j.name for j in skel.joints] == ["root", "left", "right"]
-    assert any("root joints" in n for n in g.notes)
-    assert np.allclose(skin_positions(g.character.skin, skel.world_matrices()), scene.skinned_positions(0, None))
+    g = character_from_gltf(scene)
+    ch = g.character
+    skel = ch.skeleton
+    # The still, scaled armature above both roots is the placement; the roots stay roots.
+    assert [j.name for j in skel.joints] == ["left", "right"]
+    assert [j.parent for j in skel.joints] == [None, None]
+    assert np.allclose(skel.placement, np.diag([2.0, 2.0, 2.0, 1.0]))
+    assert np.allclose(skin_positions(ch.skin, ch.skinning_world(skel.world_matrices())),
+                       scene.skinned_positions(0, None))
     doc = Document()
-    ids = _channel_ids("two", skel.joint_keys())
-    channels = {cid: ch for cid, ch in zip(ids, g.channels) if ch is not None}
-    UndoStack(doc).push(AddAsset(Asset("two", ASSET_KIND, None, {}), g.character, channels))
-    for t, tol in ((0.0, 1e-9), (0.3, 1e-9), (0.35, 1e-2), (1.0, 1e-9)):
+    channels = {f"two/{rel}": c for rel, c in ch.clips[0].channels.items()}
+    UndoStack(doc).push(AddAsset(Asset("two", ASSET_KIND, None, {"clip": ch.clips[0].name}), ch, channels))
+    for t in (0.0, 0.3, 0.35, 0.5, 1.0):
         ref = scene.skinned_positions(0, t)
-        assert np.allclose(skinned_mesh(doc, "two", t)[0], ref, atol=tol), t
+        assert np.allclose(skinned_mesh(doc, "two", t)[0], ref, atol=1e-12), t

@@ -267,7 +267,8 @@ def test_to_skeleton_and_clip_channels_pose_like_the_clip(shared_data: Path, nam
     from qtanimator.core.clip import apply_clip
 
     clip = load_bvh(_bvh(shared_data, name))
-    skeleton, channels = clip.to_skeleton()
+    skeleton, channels, moving = clip.to_skeleton()
+    assert moving == {}
     assert skeleton.names == clip.joint_names
     assert [j.rotation_order[:len(b.rotation_order)] for j, b in zip(skeleton.joints, clip.joints)] == \
         [b.rotation_order for b in clip.joints]
@@ -277,7 +278,19 @@ def test_to_skeleton_and_clip_channels_pose_like_the_clip(shared_data: Path, nam
         np.testing.assert_allclose(skeleton.world_matrices(), clip.world_matrices(float(t)), atol=1e-9)
 
 
-def test_to_skeleton_refuses_what_a_skeleton_cannot_hold() -> None:
+def test_to_skeleton_gives_a_joint_that_moves_translation_channels() -> None:
+    from qtanimator.core.clip import apply_clip
+
     text = SMALL.replace("CHANNELS 3 Xrotation Yrotation Zrotation", "CHANNELS 3 Xposition Yrotation Zrotation")
-    with pytest.raises(ValueError, match="position channels"):
-        parse_bvh(text).to_skeleton()
+    clip = parse_bvh(text)
+    for convention in ("relative", "absolute"):
+        skeleton, channels, moving = clip.to_skeleton(convention)
+        assert moving and all(skeleton.joints[j].translates for j in moving)
+        for t in np.linspace(0.0, clip.duration, 5):
+            apply_clip(skeleton, channels, float(t))
+            for j, chans in moving.items():
+                for axis, ch in enumerate(chans):
+                    if ch is not None:
+                        skeleton.joints[j].translation[axis] = ch.evaluate(float(t))
+            np.testing.assert_allclose(skeleton.world_matrices(), clip.world_matrices(float(t), positions=convention),
+                                       atol=1e-9)

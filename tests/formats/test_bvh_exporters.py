@@ -120,7 +120,12 @@ def _character_positions(path: Path, frames: list[int], positions: str | None = 
     skeleton = character.skeleton.copy()
     out = []
     for f in frames:
-        apply_clip(skeleton, channels, f * clip.frame_time)
+        t = f * clip.frame_time
+        apply_clip(skeleton, channels, t)
+        for j, chans in character.translations.items():  # joints below the root that move
+            for axis, ch in enumerate(chans):
+                if ch is not None:
+                    skeleton.joints[j].translation[axis] = ch.evaluate(t)
         out.append(skeleton.world_matrices()[:, :3, 3])
     return np.array(out)
 
@@ -176,7 +181,7 @@ def test_relative_positions_on_every_joint(tmp_path: Path) -> None:
     _assert_same(_character_positions(path, frames), ref, path)
 
 
-def test_a_joint_that_really_moves_is_refused_by_name(tmp_path: Path) -> None:
+def test_a_joint_that_really_moves_gets_translation_channels(tmp_path: Path) -> None:
     path = _rewrite(CMU, tmp_path / "moving.bvh", positions_everywhere=True, frames=10)
     text = path.read_text().splitlines()
     head_end = text.index("MOTION")
@@ -186,8 +191,11 @@ def test_a_joint_that_really_moves_is_refused_by_name(tmp_path: Path) -> None:
     row[col] = repr(float(row[col]) + 2.0)
     text[head_end + 4] = " ".join(row)
     path.write_text("\n".join(text) + "\n")
-    with pytest.raises(FormatError, match="'LeftLeg' moves"):
-        load_bvh_character(path)
+    character, _ = load_bvh_character(path, "absolute")
+    assert list(character.translations) == [3]  # LeftLeg moves: translation channels
+    frames = _frames(path, 1)
+    # bvhio reads positions as absolute (they replace the OFFSET), whatever the file looks like
+    _assert_same(_character_positions(path, frames, "absolute"), _bvhio_positions(path, frames), path)
 
 
 @pytest.mark.parametrize("extra", [["0 " * 96], ["0 " * 96, "1 2 3"], ["KEYS 1 2", "Hips 3 4"]])
