@@ -19,12 +19,14 @@ normalised (nlerp): still a rotation, close to the slerp.
 
 from __future__ import annotations
 
+import math
+from bisect import bisect_right
 from collections.abc import Sequence
 
 import numpy as np
 import numpy.typing as npt
 
-from qtanimator.core.channel import Channel
+from qtanimator.core.channel import Channel, Interpolation
 from qtanimator.core.rotation import normalize, slerp
 
 FloatArray = npt.NDArray[np.float64]
@@ -74,8 +76,69 @@ def quaternions_at(channels: Sequence[Channel | None], rest: npt.ArrayLike, time
 
 
 def quaternion_at(channels: Sequence[Channel | None], rest: npt.ArrayLike, time: float) -> FloatArray:
-    """One ``(x, y, z, w)`` quaternion at ``time`` (see :func:`quaternions_at`)."""
-    return quaternions_at(channels, rest, [time])[0]
+    """One ``(x, y, z, w)`` quaternion at ``time`` (see :func:`quaternions_at`).
+
+    The common case, a slerp span of aligned channels, runs in plain Python floats on
+    key arrays prepared once per set of channels: posing a character evaluates every joint
+    at one time, and numpy's per-call cost would dominate."""
+    plan = _plan(channels)
+    t = float(time)
+    if plan is not None:
+        times, keys, linear = plan
+        if times[0] < t < times[-1]:
+            i = bisect_right(times, t) - 1
+            if linear[i]:
+                u = (t - times[i]) / (times[i + 1] - times[i])
+                return np.array(_slerp_floats(keys[i], keys[i + 1], u))
+    return quaternions_at(channels, rest, [t])[0]
+
+
+_Plan = tuple[list[float], list[tuple[float, float, float, float]], list[bool]]
+
+
+def _plan(channels: Sequence[Channel | None]) -> _Plan | None:
+    """Key times, key quaternions and linear-span flags of four aligned channels (cached on
+    the first channel, with the identities of the other three), or None."""
+    first = channels[0]
+    if first is None:
+        return None
+    cached = first._derived.get("quaternion_plan")
+    ids = tuple(id(c) for c in channels)
+    if cached is not None and cached[0] == ids:
+        plan: _Plan | None = cached[1]
+        return plan
+    # Straight from the keys: the channels need not be compiled for this.
+    plan = None
+    if all(c is not None and len(c.keys) == len(first.keys) for c in channels) and len(first.keys) >= 2:
+        times = [k.time for k in first.keys]
+        if all([k.time for k in c.keys] == times for c in channels[1:] if c is not None):
+            w, x, y, z = ([k.value for k in c.keys] for c in channels if c is not None)
+            keys = []
+            for q in zip(x, y, z, w):
+                n = math.sqrt(sum(v * v for v in q)) or 1.0
+                keys.append((q[0] / n, q[1] / n, q[2] / n, q[3] / n))
+            linear = [all(c.keys[i].interpolation is Interpolation.LINEAR for c in channels if c is not None)
+                      for i in range(len(times) - 1)]
+            plan = (times, keys, linear)
+    # the other channels are kept alive with the plan, so their ids stay theirs
+    first._derived["quaternion_plan"] = (ids, plan, tuple(channels))
+    return plan
+
+
+def _slerp_floats(a: Sequence[float], b: Sequence[float], u: float) -> list[float]:
+    """:func:`qtanimator.core.rotation.slerp` for one pair, in floats (same formula)."""
+    d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]
+    if d < 0.0:
+        b = [-x for x in b]
+        d = -d
+    if d > 0.9995:
+        out = [(1.0 - u) * x + u * y for x, y in zip(a, b)]
+        n = math.sqrt(sum(x * x for x in out)) or 1.0
+        return [x / n for x in out]
+    theta = math.acos(min(d, 1.0))
+    s = math.sin(theta)
+    wa, wb = math.sin((1.0 - u) * theta) / s, math.sin(u * theta) / s
+    return [wa * x + wb * y for x, y in zip(a, b)]
 
 
 def _linear_spans(channels: Sequence[Channel | None]) -> npt.NDArray[np.bool_]:

@@ -41,7 +41,7 @@ import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Interpolation, Key, Tangent
 from qtanimator.core.clip import ROOT, AnimationClip, channel_count, channel_target
-from qtanimator.core.quaternion_channels import QUATERNION_DOFS, quaternions_at
+from qtanimator.core.quaternion_channels import QUATERNION_DOFS, quaternion_at
 from qtanimator.core.rotation import euler_to_quaternions, quaternions_to_euler, same_hemisphere
 from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skeleton, axis_index
 from qtanimator.core.skinning import (
@@ -727,7 +727,7 @@ def pose_skeleton(doc: Document, asset_id: str, time: float) -> Skeleton:
                 quats.append(q / (np.linalg.norm(q) or 1.0))
             elif any(c is not None and c.keys for c in chans):
                 quat_joints.append(j)
-                quats.append(quaternions_at(chans, ch.rest_quaternions()[j], [t])[0])
+                quats.append(quaternion_at(chans, ch.rest_quaternions()[j], t))
         else:
             for a, dof in enumerate(JOINT_DOFS):
                 v = value(prefix + dof)

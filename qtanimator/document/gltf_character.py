@@ -35,7 +35,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key, Tangent
+from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key
 from qtanimator.core.rotation import euler_from_matrices, matrices_to_quaternions, polar, quaternion_to_matrix
 from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skeleton
 from qtanimator.core.skinning import Skin, SkinBinding, vertex_normals
@@ -149,13 +149,9 @@ def _keys(sampler: GltfSampler, column: int, start: int = 0) -> list[Key]:
     times = sampler.times
     if sampler.interpolation == "CUBICSPLINE":
         vals = sampler.values  # (K, 3, n): in-tangent, value, out-tangent
-        return [Key(float(t), float(vals[k, 1, column]), Tangent.FIXED, Tangent.FIXED,
-                    float(vals[k, 0, column]), float(vals[k, 2, column]), Interpolation.CUBIC)
-                for k, t in enumerate(times)]
+        return Key.series(times, vals[:, 1, column], Interpolation.CUBIC, vals[:, 0, column], vals[:, 2, column])
     interp = Interpolation.CONSTANT if sampler.interpolation == "STEP" else Interpolation.LINEAR
-    v = sampler.values
-    return [Key(float(t), float(v[k, column]), Tangent.LINEAR, Tangent.LINEAR, interpolation=interp)
-            for k, t in enumerate(times)]
+    return Key.series(times, sampler.values[:, column], interp)
 
 
 def _channel(keys: list[Key]) -> Channel:

@@ -166,3 +166,37 @@ def test_euler_to_quaternion_matches_the_product_of_axis_turns():
     expected = quaternion_to_matrix(_about([0, 0, 1], 2.0)) @ quaternion_to_matrix(
         _about([0, 1, 0], -1.2)) @ quaternion_to_matrix(_about([1, 0, 0], 0.3))
     assert np.allclose(quaternion_to_matrix(q), expected, atol=1e-12)
+
+
+def test_one_time_path_equals_the_array_path_and_notices_a_changed_channel():
+    from qtanimator.core.quaternion_channels import quaternion_at
+
+    rng = np.random.default_rng(11)
+    q = rng.normal(size=(6, 4))
+    q /= np.linalg.norm(q, axis=1, keepdims=True)
+    chans = _quat_channels([0.0, 0.4, 1.0, 1.3, 2.0, 2.2], list(q))
+    times = np.linspace(-0.2, 2.4, 41)
+    batch = quaternions_at(chans, [0, 0, 0, 1], times)
+    for t, b in zip(times, batch):
+        assert np.allclose(quaternion_at(chans, [0, 0, 0, 1], t), b, atol=1e-12)
+    # the plan is cached on the first channel: replacing another channel must not reuse it
+    changed = list(chans)
+    changed[1] = Channel([Key(k.time, -k.value, Tangent.LINEAR, Tangent.LINEAR, interpolation=Interpolation.LINEAR)
+                          for k in chans[1].keys])
+    again = quaternions_at(changed, [0, 0, 0, 1], times)
+    for t, b in zip(times, again):
+        assert np.allclose(quaternion_at(changed, [0, 0, 0, 1], t), b, atol=1e-12)
+
+
+def test_key_series_builds_the_same_keys_as_one_by_one_and_checks_them():
+    times, values = [0.0, 0.5, 1.25], [1.0, -2.0, 3.5]
+    linear = Key.series(times, values, Interpolation.CONSTANT)
+    assert linear == [Key(t, v, Tangent.LINEAR, Tangent.LINEAR, interpolation=Interpolation.CONSTANT)
+                      for t, v in zip(times, values)]
+    cubic = Key.series(times, values, Interpolation.CUBIC, [0.1, 0.2, 0.3], [-1.0, -2.0, -3.0])
+    assert cubic == [Key(t, v, Tangent.FIXED, Tangent.FIXED, a, b, Interpolation.CUBIC)
+                     for t, v, a, b in zip(times, values, [0.1, 0.2, 0.3], [-1.0, -2.0, -3.0])]
+    with pytest.raises(ValueError, match="finite"):
+        Key.series([0.0, 1.0], [0.0, float("nan")], Interpolation.LINEAR)
+    with pytest.raises(ValueError, match="slopes"):
+        Key.series([0.0, 1.0], [0.0, 1.0], Interpolation.CUBIC, [0.0, float("inf")], [0.0, 0.0])

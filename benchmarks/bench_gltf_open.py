@@ -1,0 +1,98 @@
+"""glTF file-open time per sample (issue 21, item 4): what File ▸ Open costs (read the file,
+build the whole character, every clip, apply the import to a document) against pygltflib's
+load of the same file (parsing only: it decodes no accessor). Median [min-max] over
+interleaved runs. Besides ../shared/data/gltf, a generated character (tests/gltf_gen.big_clip:
+59 meshes on one skin, 60 joints, one 35 s clip keyed on every joint at 30 fps) is timed, and
+posing it at one frame (what playback pays per frame) is reported beside.
+
+    .venv/bin/python -m benchmarks.bench_gltf_open [--repeats N] [--out PATH]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from datetime import date
+from pathlib import Path
+
+from qtanimator.document import Document, UndoStack
+from qtanimator.document.character3d import skinned_mesh
+from qtanimator.document.import3d import import_file
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT.parent / "shared" / "data" / "gltf"
+
+
+def _open(path: str) -> tuple[Document, str]:
+    doc = Document()
+    imp = import_file(doc, path)
+    UndoStack(doc).push(imp.command)
+    return doc, imp.asset_id
+
+
+def _times(fns: dict[str, Callable[[], object]], repeats: int) -> dict[str, list[float]]:
+    for fn in fns.values():
+        fn()
+    out: dict[str, list[float]] = {name: [] for name in fns}
+    for _ in range(repeats):
+        for name, fn in fns.items():  # taking turns: a burst of load hits both alike
+            start = time.perf_counter()
+            fn()
+            out[name].append(time.perf_counter() - start)
+    return out
+
+
+def _fmt(ts: list[float]) -> str:
+    ms = [t * 1e3 for t in ts]
+    return f"{statistics.median(ms):.2f} [{min(ms):.2f}-{max(ms):.2f}] ms"
+
+
+def run(repeats: int) -> list[str]:
+    import pygltflib
+
+    sys.path.insert(0, str(ROOT / "tests"))
+    from gltf_gen import big_clip
+
+    tmp = Path(tempfile.mkdtemp(prefix="bench_gltf_"))
+    files = [*sorted(DATA.glob("*.gl*")), big_clip(tmp)]
+    lines = [f"# benchmarks/bench_gltf_open.py, {date.today()}, {os.cpu_count()}-core machine, "
+             f"pygltflib {pygltflib.__version__ if hasattr(pygltflib, '__version__') else '?'}, "
+             f"{repeats} runs each; load average before {os.getloadavg()[0]:.2f}",
+             "file | size | meshes / joints / clips (keys) | qtanimator open (read + character + document) | "
+             "pygltflib.GLTF2.load | ratio ours/pygltflib | pose + skin one frame"]
+    for path in files:
+        p = str(path)
+        times = _times({"ours": lambda p=p: _open(p),  # type: ignore[misc]
+                        "pygltflib": lambda p=p: pygltflib.GLTF2.load(p)}, repeats)  # type: ignore[misc]
+        doc, aid = _open(p)
+        ch = doc.runtime[aid]
+        keys = sum(len(c.keys) for c in doc.channels.values())
+        mid = 0.5 * (ch.clips[0].start + ch.clips[0].end) if ch.clips else 0.0
+        frame = _times({"pose": lambda d=doc, a=aid, t=mid: skinned_mesh(d, a, t)}, repeats)["pose"]  # type: ignore[misc]
+        ratio = statistics.median(times["ours"]) / statistics.median(times["pygltflib"])
+        lines.append(f"{path.name} | {path.stat().st_size:,} B | {len(ch.parts)} / {len(ch.skeleton.joints)} / "
+                     f"{len(ch.clips)} ({keys:,}) | {_fmt(times['ours'])} | {_fmt(times['pygltflib'])} | "
+                     f"{ratio:.2f} | {_fmt(frame)}")
+    lines.append(f"# load average after {os.getloadavg()[0]:.2f}")
+    return lines
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--repeats", type=int, default=11)
+    parser.add_argument("--out", type=Path, default=None)
+    args = parser.parse_args()
+    lines = run(args.repeats)
+    text = "\n".join(lines) + "\n"
+    print(text, end="")
+    if args.out is not None:
+        args.out.write_text(text)
+
+
+if __name__ == "__main__":
+    main()
