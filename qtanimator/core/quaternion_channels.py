@@ -26,15 +26,15 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from qtanimator.core.channel import Channel, Interpolation
-from qtanimator.core.rotation import normalize, slerp
+from qtanimator.core.channel import Channel, Interpolation, Key
+from qtanimator.core.rotation import euler_filter, euler_to_quaternions, normalize, quaternions_to_euler, slerp
 
 FloatArray = npt.NDArray[np.float64]
 
 #: Channel names of the components, in the order of the ``channels`` arguments below.
 QUATERNION_DOFS = ("qw", "qx", "qy", "qz")
 
-__all__ = ["QUATERNION_DOFS", "quaternion_at", "quaternions_at"]
+__all__ = ["QUATERNION_DOFS", "euler_channels", "quaternion_at", "quaternion_channels", "quaternions_at"]
 
 
 def _aligned(channels: Sequence[Channel | None]) -> FloatArray | None:
@@ -159,3 +159,52 @@ def _key_quaternions(channels: Sequence[Channel | None]) -> FloatArray:
         cols.append(ch.values)
     w, x, y, z = cols
     return normalize(np.stack([x, y, z, w], axis=1))
+
+
+def _sample_times(channels: Sequence[Channel | None], fps: float) -> FloatArray:
+    """Key times of the channels plus a grid at ``fps`` between the first and the last."""
+    keyed = [c.times for c in channels if c is not None and c.keys]
+    if not keyed:
+        return np.zeros(0)
+    times = np.concatenate(keyed)
+    t0, t1 = float(times.min()), float(times.max())
+    n = int(np.floor((t1 - t0) * fps + 1e-9)) + 1
+    grid = t0 + np.arange(n, dtype=np.float64) / fps
+    out = np.unique(np.concatenate([times, grid[grid <= t1]]))
+    keep = np.concatenate([[True], np.diff(out) > 1e-9])
+    result: FloatArray = out[keep]
+    return result
+
+
+def _linear_keys(times: FloatArray, values: FloatArray) -> Channel:
+    return Channel(Key.series(times, values, Interpolation.LINEAR))
+
+
+def euler_channels(channels: Sequence[Channel | None], rest: npt.ArrayLike, order: str,
+                   fps: float) -> list[Channel | None]:
+    """The ``rx, ry, rz`` channels (radians, linear keys) of a quaternion-keyed rotation:
+    sampled at its key times and ``fps`` between, made continuous (the Euler filter). Exact
+    at the samples; between them Euler angles are blended, not slerped."""
+    times = _sample_times(channels, fps)
+    if len(times) == 0:
+        return [None, None, None]
+    euler = euler_filter(quaternions_to_euler(quaternions_at(channels, rest, times), order), order)
+    return [_linear_keys(times, euler[:, a]) for a in range(3)]
+
+
+def quaternion_channels(channels: Sequence[Channel | None], rest: npt.ArrayLike, order: str,
+                        fps: float) -> list[Channel | None]:
+    """The ``qw, qx, qy, qz`` channels (linear keys: slerp spans) of an Euler-keyed rotation
+    (``rx, ry, rz``; ``rest`` the Euler angles where one has no channel), sampled at its key
+    times and ``fps`` between, each key on the side of the previous one."""
+    times = _sample_times(channels, fps)
+    if len(times) == 0:
+        return [None, None, None, None]
+    r = np.asarray(rest, dtype=np.float64).reshape(3)
+    angles = np.stack([r[a] if c is None or not c.keys else c.evaluate(times)
+                       for a, c in enumerate(channels)], axis=-1).reshape(len(times), 3)
+    q = euler_to_quaternions(angles, order)
+    for k in range(1, len(q)):
+        if float(np.dot(q[k], q[k - 1])) < 0.0:
+            q[k] = -q[k]
+    return [_linear_keys(times, q[:, slot]) for slot in (3, 0, 1, 2)]

@@ -30,6 +30,7 @@ skeleton joints through :attr:`Character3D.palette`.
 
 from __future__ import annotations
 
+import dataclasses
 import os
 from collections.abc import Hashable, Mapping
 from dataclasses import dataclass, field
@@ -41,7 +42,7 @@ import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Interpolation, Key, Tangent
 from qtanimator.core.clip import ROOT, AnimationClip, channel_count, channel_target
-from qtanimator.core.quaternion_channels import QUATERNION_DOFS, quaternion_at
+from qtanimator.core.quaternion_channels import QUATERNION_DOFS, euler_channels, quaternion_at, quaternion_channels
 from qtanimator.core.rotation import euler_to_quaternions, quaternions_to_euler, same_hemisphere
 from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skeleton, axis_index
 from qtanimator.core.skinning import (
@@ -82,16 +83,20 @@ SCALE_DOFS = ("sx", "sy", "sz")
 #: The asset properties of the active clip's name and of the clips edited and left.
 CLIP = "clip"
 CLIP_STORE = "clip_store"
+#: The asset property saying how rotations are keyed: "quaternion" or "euler" (absent: as
+#: the file has them; glTF quaternion, the others Euler).
+ROTATION_MODE = "rotation_mode"
+ROTATION_MODES = ("quaternion", "euler")
 
 __all__ = [
     "ASSET_KIND", "BVH_POSITIONS", "BvhCharacter", "CLIP", "CLIP_STORE", "Character3D", "ClipSource", "MeshPart",
-    "QUAT_DOFS", "SCALE_DOFS", "TRANSLATE_DOFS", "active_clip", "add_character3d_command", "all_channel_ids",
-    "bvh_positions", "bvh_positions_note", "channel_dofs", "channel_ids", "character", "clip_channels_of",
-    "clip_from_document", "clip_range_command", "dof_channel_id", "dof_values", "ik_values", "joint_channel_names",
-    "load_anim_command", "load_bvh_character", "load_character3d", "load_character3d_asset", "new_key",
-    "pose_channel_values",
-    "pose_skeleton", "set_bvh_positions_command", "set_clip_command", "set_dof_command", "set_dofs_command",
-    "skinned_mesh", "world_matrices",
+    "QUAT_DOFS", "ROTATION_MODE", "ROTATION_MODES", "SCALE_DOFS", "TRANSLATE_DOFS", "active_clip",
+    "add_character3d_command", "all_channel_ids", "bvh_positions", "bvh_positions_note", "channel_dofs",
+    "channel_ids", "character", "clip_channels_of", "clip_from_document", "clip_range_command", "dof_channel_id",
+    "dof_values", "ik_values", "joint_channel_names", "load_anim_command", "load_bvh_character", "load_character3d",
+    "load_character3d_asset", "new_key", "pose_channel_values", "pose_skeleton", "rotation_mode",
+    "set_bvh_positions_command", "set_clip_command", "set_dof_command", "set_dofs_command",
+    "set_rotation_mode_command", "skinned_mesh", "with_rotation_mode", "world_matrices",
 ]
 
 
@@ -321,7 +326,12 @@ def set_bvh_positions_command(doc: Document, asset_id: str, value: str) -> Comma
 
 
 def load_character3d_asset(asset: Asset) -> Character3D:
-    """The registered loader for :data:`ASSET_KIND` (a project being opened)."""
+    """The registered loader for :data:`ASSET_KIND` (a project being opened), in the
+    rotation mode the asset keeps (:data:`ROTATION_MODE`)."""
+    return with_rotation_mode(_load_character3d_asset(asset), asset.properties.get(ROTATION_MODE))
+
+
+def _load_character3d_asset(asset: Asset) -> Character3D:
     if not asset.source:
         raise FormatError(f"3D character {asset.id!r} has no skeleton file.")
     suffix = Path(asset.source).suffix.lower()
@@ -620,8 +630,12 @@ def clip_channels_of(doc: Document, asset_id: str, name: str) -> dict[str, Chann
         return dict(doc.channels_of(asset_id))
     stored = (doc.assets[asset_id].properties.get(CLIP_STORE) or {}).get(name)
     if isinstance(stored, dict):
-        return {f"{asset_id}/{rel}": Channel.from_dict(d) for rel, d in stored.items()}
-    return {f"{asset_id}/{rel}": c for rel, c in clip.channels.items()}
+        rel = {r: Channel.from_dict(d) for r, d in stored.items()}
+    else:
+        rel = dict(clip.channels)
+    # The file's keys are quaternions; joints switched to Euler get them converted.
+    rel = _in_rotation_mode(ch, rel, doc.fps)
+    return {f"{asset_id}/{r}": c for r, c in rel.items()}
 
 
 def clip_duration(doc: Document, asset_id: str, name: str) -> tuple[float, float]:
@@ -681,6 +695,76 @@ def set_clip_command(doc: Document, asset_id: str, name: str) -> Command:
     if rng is not None:
         commands.append(rng)
     return Macro(f"Play clip {name}", commands)
+
+
+# ----------------------------------------------------------------- rotation mode
+def rotation_mode(ch: Character3D) -> str:
+    """"quaternion" when the character's joints are keyed as quaternions, else "euler"."""
+    return "quaternion" if any(j.quaternion for j in ch.skeleton.joints) else "euler"
+
+
+def with_rotation_mode(ch: Character3D, mode: Any) -> Character3D:
+    """``ch`` with every joint keyed in ``mode`` ("quaternion" / "euler"); ``ch`` itself
+    when it is so already or ``mode`` is not one of :data:`ROTATION_MODES`."""
+    if mode not in ROTATION_MODES or rotation_mode(ch) == mode and all(
+            j.quaternion == (mode == "quaternion") for j in ch.skeleton.joints):
+        return ch
+    rest = ch.rest_quaternions().copy()
+    skel = ch.skeleton.copy()
+    for i, j in enumerate(skel.joints):
+        if not ch.skeleton.joints[i].quaternion:
+            rest[i] = euler_to_quaternions(j.pose, j.rotation_order or skel.rotation_order)[0]
+        j.quaternion = mode == "quaternion"
+    new = dataclasses.replace(ch, skeleton=skel)
+    new._rest_quaternions = rest
+    return new
+
+
+def _in_rotation_mode(ch: Character3D, rel: dict[str, Channel], fps: float) -> dict[str, Channel]:
+    """Asset-relative channels with each joint's rotation keyed the way the joint is:
+    quaternion channels of an Euler joint become Euler ones and the other way round (both
+    sampled at the keys and ``fps``; see :mod:`qtanimator.core.quaternion_channels`)."""
+    skel = ch.skeleton
+    out = dict(rel)
+    for j, (key, joint) in enumerate(zip(skel.joint_keys(), skel.joints)):
+        order = joint.rotation_order or skel.rotation_order
+        q_ids = [f"{key}/{d}" for d in QUAT_DOFS]
+        r_ids = [f"{key}/{d}" for d in JOINT_DOFS]
+        if not joint.quaternion and any(i in out for i in q_ids):
+            new = euler_channels([out.pop(i, None) for i in q_ids], ch.rest_quaternions()[j], order, fps)
+            out.update({i: c for i, c in zip(r_ids, new) if c is not None})
+        elif joint.quaternion and any(i in out for i in r_ids):
+            new = quaternion_channels([out.pop(i, None) for i in r_ids], joint.pose, order, fps)
+            out.update({i: c for i, c in zip(q_ids, new) if c is not None})
+    return out
+
+
+def set_rotation_mode_command(doc: Document, asset_id: str, mode: str) -> Command:
+    """One undo step that keys the character's rotations as quaternions or Euler angles
+    (Blender's rotation mode): the joints switch, and the rotation channels of the active
+    clip and of the clips kept in ``clip_store`` are converted (sampled at their keys and
+    the frame rate; exact there, blended in the new form between). Raises ValueError for an
+    unknown mode."""
+    if mode not in ROTATION_MODES:
+        raise ValueError(f"unknown rotation mode {mode!r}; expected one of {', '.join(ROTATION_MODES)}")
+    ch = character(doc, asset_id)
+    new_ch = with_rotation_mode(ch, mode)
+    asset = doc.assets[asset_id]
+    prefix = f"{asset_id}/"
+    old = {cid[len(prefix):]: c for cid, c in doc.channels_of(asset_id)}
+    new = _in_rotation_mode(new_ch, old, doc.fps)
+    changes = {prefix + r: (old.get(r), new.get(r)) for r in dict.fromkeys([*old, *new])
+               if old.get(r) is not new.get(r)}
+    new_asset = asset.copy()
+    new_asset.properties[ROTATION_MODE] = mode
+    store = asset.properties.get(CLIP_STORE)
+    if isinstance(store, dict):
+        new_asset.properties[CLIP_STORE] = {
+            name: {r: c.to_dict() for r, c in _in_rotation_mode(
+                new_ch, {r: Channel.from_dict(d) for r, d in kept.items()}, doc.fps).items()}
+            for name, kept in store.items() if isinstance(kept, dict)}
+    return Macro(f"Rotation mode: {mode}", [AddAsset(new_asset, new_ch, text="Rotation mode"),
+                                             SetChannels("Convert rotations", changes)])
 
 
 # -------------------------------------------------------------------- evaluation
