@@ -18,7 +18,10 @@ Shots (``docs/images/NAME.png``):
 * ``joint_tree`` — the Joints dock with the 3D arm's elbow selected and its DOF sliders;
 * ``pendulum_properties`` — the Properties dock for Pip's pendulum lantern;
 * ``cloth_panel`` — the Cloth dock with the flag;
-* ``export_dialog`` — File ▸ Export Animation….
+* ``export_dialog`` — File ▸ Export Animation…;
+* ``gltf_clips`` — a glTF character with three clips (built here with ``tests/gltf_gen.py``'s
+  builder: no such file is in the shared samples), its clip picked in Properties and the
+  3D view's clip list open.
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ OUT = REPO / "docs" / "images"
 MAX_WIDTH = 1400
 WINDOW_SIZE = (1400, 900)
 SHOTS = ("main_window", "curve_editor", "viewport_3d", "joint_tree", "pendulum_properties", "cloth_panel",
-         "export_dialog")
+         "export_dialog", "gltf_clips")
 
 
 # ------------------------------------------------------------------ display
@@ -298,6 +301,156 @@ class Shooter:
         dialog.reject()
 
 
+    # -------------------------------------------------------------- glTF clips
+    def gltf_clips(self) -> None:
+        """A glTF character with three clips: "wave" picked in Properties (a real click on the
+        combo's list), then the 3D view's clip list opened on "walk"; the screen is grabbed so
+        that the open list is in the picture."""
+        from PySide6.QtCore import QPoint, Qt
+        from PySide6.QtTest import QTest
+        from PySide6.QtWidgets import QApplication, QComboBox
+
+        folder = Path(tempfile.mkdtemp(prefix="qtanimator-clips-"))
+        try:
+            path = clips_character(folder)
+            self.window.ctx.undo_stack.setClean()
+            self.window.new_document()
+            if not self.window.open_path(path):
+                sys.exit("make_screenshots: the clips character did not open")
+        finally:
+            shutil.rmtree(folder, ignore_errors=True)
+        aid = self.ctx.selection[0]
+        self.tab("3D")
+        props = dock(self.window, "propertiesDock")
+        props.raise_()
+        settle(self.app, 0.5)
+
+        def choose(combo: QComboBox, text: str) -> None:
+            QTest.mouseClick(combo, Qt.MouseButton.LeftButton)
+            settle(self.app, QApplication.doubleClickInterval() / 1000 + 0.2)
+            view = combo.view()
+            rect = view.visualRect(view.model().index(combo.findText(text), 0))
+            QTest.mouseMove(view.viewport(), rect.center())
+            QTest.mouseClick(view.viewport(), Qt.MouseButton.LeftButton, Qt.KeyboardModifier.NoModifier,
+                             rect.center())
+            settle(self.app, 0.4)
+
+        panel = self.window.properties_panel
+        choose(panel.findChild(QComboBox, "characterClip"), "wave (1.5 s)")
+        self.ctx.set_frame(36.0)
+        self.ctx.select(aid, "forearm_r")
+        view = self.window.viewport3d
+        view.frame_all()
+        view.camera.azimuth, view.camera.inclination = 20.0, 10.0
+        view.camera.zoom(0.9)
+        view.update()
+        settle(self.app, 0.8)
+        bar = self.window.viewport_panel.findChild(QComboBox, "viewportClip")
+        QTest.mouseClick(bar, Qt.MouseButton.LeftButton)
+        settle(self.app, 0.6)
+        bar.view().setCurrentIndex(bar.view().model().index(bar.findText("walk (1 s)"), 0))
+        settle(self.app, 0.3)
+        origin = self.window.mapToGlobal(QPoint(0, 0))
+        shot = self.window.screen().grabWindow(0, origin.x(), origin.y(), self.window.width(),
+                                               self.window.height())
+        bar.hidePopup()
+        save_png(shot, self.out / "gltf_clips.png")
+
+
+def clips_character(folder: Path) -> Path:
+    """``clips.glb``: a small skinned figure of coloured parts (shirt, sleeves, trousers, skin,
+    shoes) with three animations of different lengths: "idle" (2 s), "wave" (1.5 s) and a
+    looping "walk" (1 s). Built with the glTF builder of ``tests/gltf_gen.py``."""
+    import numpy as np
+
+    sys.path.insert(0, str(REPO / "tests"))
+    try:
+        from gltf_gen import Builder, column, merge, quat
+    finally:
+        sys.path.remove(str(REPO / "tests"))
+
+    b = Builder("clips")
+    pelvis = b.node("pelvis", translation=[0.0, 1.0, 0.0])
+    chest = b.node("chest", pelvis, translation=[0.0, 0.4, 0.0])
+    head = b.node("head", chest, translation=[0.0, 0.35, 0.0])
+    joints = [pelvis, chest, head]
+    limbs = {}
+    for side, sx in (("l", 1.0), ("r", -1.0)):
+        arm = b.node(f"arm_{side}", chest, translation=[0.3 * sx, 0.25, 0.0])
+        forearm = b.node(f"forearm_{side}", arm, translation=[0.0, -0.32, 0.0])
+        leg = b.node(f"leg_{side}", pelvis, translation=[0.13 * sx, -0.05, 0.0])
+        knee = b.node(f"knee_{side}", leg, translation=[0.0, -0.45, 0.0])
+        limbs[side] = (arm, forearm, leg, knee)
+        joints += [arm, forearm, leg, knee]
+    at = {j: b.rest_global(j)[:3, 3] for j in joints}
+    # Each vertex follows the bone it lies on: a joint's anchor is the middle of its bone.
+    down = np.array([0.0, -0.3, 0.0])
+    ends = {pelvis: at[pelvis] + [0, -0.05, 0], chest: at[chest] + [0, 0.15, 0], head: at[head] + [0, 0.18, 0]}
+    for arm, forearm, leg, knee in limbs.values():
+        ends.update({arm: (at[arm] + at[forearm]) / 2, forearm: at[forearm] + down / 2,
+                     leg: (at[leg] + at[knee]) / 2, knee: at[knee] + [0, -0.22, 0]})
+    anchors = np.array([ends[j] for j in joints])
+    shirt = b.material("shirt", [0.08, 0.25, 0.75, 1.0])
+    sleeves = b.material("sleeves", [0.05, 0.15, 0.5, 1.0])
+    skin_tone = b.material("skin", [0.85, 0.55, 0.4, 1.0])
+    trousers = b.material("trousers", [0.25, 0.22, 0.2, 1.0])
+    shoes = b.material("shoes", [0.6, 0.08, 0.05, 1.0])
+    def part(geometry: tuple[np.ndarray, np.ndarray], material: int, bones: list[int],
+             influences: int = 2) -> dict[str, object]:
+        """A primitive weighted to the nearest of ``bones`` only (a sleeve never pulls the shirt)."""
+        ids = [joints.index(j) for j in bones]
+        return b.primitive(*geometry, material=material, anchors=anchors[ids], influences=influences, joint_ids=ids)
+
+    torso = column(at[pelvis] + [0, -0.12, 0], at[chest] + [0, 0.3, 0], 0.46, rings=6, depth=0.26)
+    neck_head = column(at[head] - [0, 0.05, 0], at[head] + [0, 0.3, 0], 0.24, rings=4)
+    sleeves_geo, hands_geo, legs_geo, shoes_geo = [], [], [], []
+    for arm, forearm, leg, knee in limbs.values():
+        sleeves_geo.append(column(at[arm] + [0, 0.05, 0], at[forearm] + down * 0.9, 0.12, rings=7))
+        hands_geo.append(column(at[forearm] + down * 0.8, at[forearm] + down * 1.3, 0.13, rings=2))
+        legs_geo.append(column(at[leg] + [0, 0.08, 0], at[knee] + [0, -0.42, 0], 0.17, rings=7))
+        shoes_geo.append(column(at[knee] + [0, -0.42, -0.05], at[knee] + [0, -0.42, 0.2], 0.14, rings=2,
+                                depth=0.08))
+    arms = [j for side in limbs.values() for j in side[:2]]
+    legs = [j for side in limbs.values() for j in side[2:]]
+    forearms = [limbs["l"][1], limbs["r"][1]]
+    figure = b.mesh([part(torso, shirt, [pelvis, chest]), part(merge(*sleeves_geo), sleeves, arms),
+                     part(neck_head, skin_tone, [head]), part(merge(*hands_geo), skin_tone, forearms, 1),
+                     part(merge(*legs_geo), trousers, legs), part(merge(*shoes_geo), shoes, legs)], "figure")
+    b.node("figure", mesh=figure, skin=0)
+    b.skin(joints, skeleton=pelvis)
+
+    def turns(axis: list[float], degrees: list[float]) -> np.ndarray:
+        return np.array([quat(axis, d) for d in degrees])
+
+    arm_l, forearm_l, leg_l, knee_l = limbs["l"]
+    arm_r, forearm_r, leg_r, knee_r = limbs["r"]
+    t3 = [0.0, 1.0, 2.0]
+    b.animation("idle", [
+        (chest, "rotation", t3, turns([0, 0, 1], [-3, 3, -3]), "LINEAR"),
+        (head, "rotation", t3, turns([1, 0, 0], [0, 8, 0]), "LINEAR"),
+        (arm_l, "rotation", t3, turns([0, 0, 1], [8, 5, 8]), "LINEAR"),
+        (arm_r, "rotation", t3, turns([0, 0, 1], [-8, -5, -8]), "LINEAR"),
+    ])
+    tw = [0.0, 0.3, 0.5, 0.7, 0.9, 1.1, 1.5]
+    b.animation("wave", [
+        (arm_r, "rotation", tw, turns([0, 0, 1], [-8, -150, -150, -150, -150, -150, -8]), "LINEAR"),
+        (forearm_r, "rotation", tw, turns([0, 0, 1], [0, 0, 35, -25, 35, 0, 0]), "LINEAR"),
+        (head, "rotation", [0.0, 0.5, 1.5], turns([0, 0, 1], [0, -10, 0]), "LINEAR"),
+    ])
+    t5 = [0.0, 0.25, 0.5, 0.75, 1.0]
+    swing = [25, 0, -25, 0, 25]
+    b.animation("walk", [
+        (leg_l, "rotation", t5, turns([1, 0, 0], [-s for s in swing]), "LINEAR"),
+        (leg_r, "rotation", t5, turns([1, 0, 0], swing), "LINEAR"),
+        (knee_l, "rotation", t5, turns([1, 0, 0], [10, 35, 5, 0, 10]), "LINEAR"),
+        (knee_r, "rotation", t5, turns([1, 0, 0], [5, 0, 10, 35, 5]), "LINEAR"),
+        (arm_l, "rotation", t5, turns([1, 0, 0], [-20, 0, 20, 0, -20]), "LINEAR"),
+        (arm_r, "rotation", t5, turns([1, 0, 0], [20, 0, -20, 0, 20]), "LINEAR"),
+        (pelvis, "translation", t5, [[0, 1.0, 0], [0, 1.04, 0], [0, 1.0, 0], [0, 1.04, 0], [0, 1.0, 0]], "LINEAR"),
+    ])
+    return b.save(folder / "clips.glb")
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description="Take the documentation screenshots from the real program.")
     ap.add_argument("--out", type=Path, default=OUT, help="output folder (default docs/images)")
@@ -320,7 +473,7 @@ def main(argv: list[str] | None = None) -> int:
     try:
         shooter = Shooter(ns.out)
         order = ["main_window", "pendulum_properties", "curve_editor", "viewport_3d", "joint_tree", "cloth_panel",
-                 "export_dialog"]
+                 "export_dialog", "gltf_clips"]  # gltf_clips last: it replaces the demo
         for name in order:
             if ns.only and name not in ns.only:
                 continue

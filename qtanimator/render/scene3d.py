@@ -9,7 +9,7 @@ picking share it.
 from __future__ import annotations
 
 import contextlib
-from collections.abc import Iterable
+from collections.abc import Iterable, Sequence
 from typing import Any
 
 import numpy as np
@@ -18,7 +18,7 @@ from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN
 from qtanimator.core.skinning import vertex_normals
 from qtanimator.document import character3d, cloth
 from qtanimator.render.gl.meshes import csr_influences
-from qtanimator.render.gl.renderer import CharacterDraw, ClothDraw, PlaneDraw, SceneItem, SkinDraw
+from qtanimator.render.gl.renderer import SKIN_COLOR, CharacterDraw, ClothDraw, PlaneDraw, SceneItem, SkinDraw
 
 CHARACTER_KIND = character3d.ASSET_KIND
 CLOTH_KIND = cloth.ASSET_KIND
@@ -113,9 +113,44 @@ def skin_draw(doc: Any, asset_id: str, world: np.ndarray) -> SkinDraw | None:
     n = min(len(world), len(inv))
     matrices = np.tile(np.eye(4), (len(inv), 1, 1))
     matrices[:n] = world[:n] @ inv[:n]
+    parts = part_colors(runtime, len(arrays["triangles"])) if isinstance(runtime, character3d.Character3D) else ()
     return SkinDraw(key=skin, positions=arrays["positions"], normals=arrays["normals"],
                     triangles=arrays["triangles"], influence=arrays["influence"], pairs=arrays["pairs"],
-                    matrices=matrices, faceted=faceted)
+                    matrices=matrices, faceted=faceted, parts=parts)
+
+
+Color = tuple[float, float, float, float]
+
+
+def display_color(linear: Sequence[float]) -> Color:
+    """A material's base colour (linear, as glTF stores it) as the colour the view draws with:
+    sRGB-encoded, as the view's other colours are (the shaders do no gamma), opaque."""
+    c = np.clip(np.asarray(linear[:3], dtype=float), 0.0, 1.0)
+    srgb = np.where(c <= 0.0031308, 12.92 * c, 1.055 * c ** (1.0 / 2.4) - 0.055)
+    return (float(srgb[0]), float(srgb[1]), float(srgb[2]), 1.0)
+
+
+def part_colors(runtime: character3d.Character3D, triangles: int) -> tuple[tuple[int, int, Color], ...]:
+    """(first triangle, triangle count, colour) ranges covering the skin's ``triangles``
+    when its mesh parts differ in colour: each part in its material's colour (triangles no
+    part holds in SKIN_COLOR). Empty when the parts share one colour (or there are none, as
+    for course characters): the skin is drawn in SKIN_COLOR, as before."""
+    parts = sorted((p for p in runtime.parts if p.triangle_count > 0), key=lambda p: p.triangle_start)
+    if len({tuple(p.color[:3]) for p in parts}) < 2:
+        return ()
+    out: list[tuple[int, int, Color]] = []
+    at = 0
+    for part in parts:
+        first = max(part.triangle_start, at)
+        end = min(part.triangle_start + part.triangle_count, triangles)
+        if first > at:
+            out.append((at, first - at, SKIN_COLOR))
+        if end > first:
+            out.append((first, end - first, display_color(part.color)))
+            at = end
+    if at < triangles:
+        out.append((at, triangles - at, SKIN_COLOR))
+    return tuple(out)
 
 
 def gpu_skin_arrays(skin: Any) -> dict[str, Any]:

@@ -3,7 +3,9 @@
 The tree follows ``ctx.selection`` and sets it; keyframed joints carry a key icon (filled
 once the joint has keys), dynamic (pendulum) joints a white bob. Below the tree, the DOF
 panel shows one slider and spin box per degree of freedom of the selected joint within
-its limits; an edit keys the DOF at the current frame, and one slider drag is one gesture
+its limits (a 3D joint: its rotation as Euler angles in its rotation order, also when it is
+keyed as a quaternion, and its translation and scale where it moves or scales); an edit
+keys the DOF at the current frame, and one slider drag is one gesture
 (``ctx.begin_gesture``): one undo step, and Escape during the drag puts the value back.
 
 Drag a 2D joint onto another joint of the same character to re-parent it (one undo step,
@@ -18,7 +20,7 @@ import math
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from types import ModuleType
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 from PySide6.QtCore import QPoint, QPointF, Qt
@@ -100,6 +102,21 @@ class DofSpec:
     #: off the slider only poses (the pending, unkeyed pose) through them.
     channel: str = ""
     to_doc: Callable[[float], float] = float
+    #: The unkeyed pose of a display value at a time, as channel values, where one value
+    #: does not map to one channel (a 3D joint keyed as a quaternion: its four components).
+    #: None: ``{channel: to_doc(value)}``.
+    preview: Callable[[float, float], dict[str, float]] | None = None
+    #: Slider steps per display unit and the spin box's decimals.
+    steps: int = SLIDER_STEPS_PER_UNIT
+    decimals: int = 2
+    #: A wider range for typed values than the slider's (None: the slider's).
+    typed_range: tuple[float, float] | None = None
+
+    def pose_values(self, value: float, time: float) -> dict[str, float]:
+        """The channel values an unkeyed pose of ``value`` at ``time`` shows."""
+        if self.preview is not None:
+            return self.preview(value, time)
+        return {self.channel: self.to_doc(value)}
 
 
 def _asset_kind(doc: Document, asset: str) -> str:
@@ -136,40 +153,101 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
 
         return [DofSpec("angle", math.degrees(angle), -360.0, 360.0, key, "°",
                         m2.angle_channel_id(asset, joint), math.radians)]
-    if m3 is not None and kind == m3.ASSET_KIND and runtime is not None and not joint:
-        posed = m3.pose_skeleton(doc, asset, time)
-        root = np.asarray(getattr(posed, "root_translation", np.zeros(3)), dtype=np.float64)
-        specs3 = []
-        for axis_i, axis in enumerate("xyz"):
-            def move3(value: float, t: float, gesture: object, a: str = axis) -> Command:
-                return m3.set_dof_command(doc, asset, None, "t" + a, value, t, gesture=gesture)
-
-            specs3.append(DofSpec(f"translate {axis}", float(root[axis_i]), -TRANSLATION_LIMIT,
-                                  TRANSLATION_LIMIT, move3, "", m3.dof_channel_id(doc, asset, None, axis)))
-        return specs3
-    if m3 is not None and kind == m3.ASSET_KIND and runtime is not None and joint:
-        skeleton = m3.pose_skeleton(doc, asset, time) if hasattr(m3, "pose_skeleton") else runtime
-        skel_joints = list(skeleton.joints)
-        names = [j.name for j in skel_joints]
-        if joint not in names:
-            return []
-        index = names.index(joint)
-        specs = []
-        for axis_i, axis in enumerate("xyz"):
-            dof = skel_joints[index].dofs[axis_i]
-            lo, hi = float(dof.min), float(dof.max)
-            if lo >= hi:
-                continue  # a locked DOF
-            lo, hi = max(lo, -math.pi), min(hi, math.pi) if math.isfinite(hi) else math.pi
-
-            def set_dof(value: float, t: float, gesture: object, a: str = axis) -> Command:
-                return m3.set_dof_command(doc, asset, index, a, math.radians(value), t, gesture=gesture)
-
-            specs.append(DofSpec(f"rotate {axis}", math.degrees(float(dof.value)), math.degrees(lo),
-                                 math.degrees(hi), set_dof, "°", m3.dof_channel_id(doc, asset, index, axis),
-                                 math.radians))
-        return specs
+    if m3 is not None and kind == m3.ASSET_KIND and runtime is not None:
+        return _dof_specs_3d(m3, doc, asset, joint, time)
     return []
+
+
+def _dof_specs_3d(m3: ModuleType, doc: Document, asset: str, joint: str, time: float) -> list[DofSpec]:
+    """A 3D character's root translation (joint ""), or a joint's rotation (Euler angles in
+    its rotation order, also for a joint keyed as a quaternion), translation and scale.
+
+    Every DOF keys through ``set_dof_command`` and previews (auto-key off) through
+    ``dof_values``, which turn one Euler angle of a quaternion joint into its four components."""
+    posed = m3.pose_skeleton(doc, asset, time)
+
+    def dof(key: tuple[int | None, str], scale: Callable[[float], float],
+            ) -> tuple[Callable[[float, float, object], Command], Callable[[float, float], dict[str, float]]]:
+        def make(value: float, t: float, gesture: object) -> Command:
+            return m3.set_dof_command(doc, asset, key[0], key[1], scale(value), t, gesture=gesture)
+
+        def preview(value: float, t: float) -> dict[str, float]:
+            return dict(m3.dof_values(doc, asset, {key: scale(value)}, t))
+
+        return make, preview
+
+    specs: list[DofSpec] = []
+    if not joint:
+        for axis_i, axis in enumerate("xyz"):
+            make, preview = dof((None, "t" + axis), float)
+            specs.append(DofSpec(f"translate {axis}", float(posed.root_translation[axis_i]), -TRANSLATION_LIMIT,
+                                 TRANSLATION_LIMIT, make, "", m3.dof_channel_id(doc, asset, None, axis),
+                                 preview=preview))
+        return specs
+    keys = posed.joint_keys()
+    names = [j.name for j in posed.joints]
+    if joint in keys:
+        index = keys.index(joint)
+    elif joint in names:
+        index = names.index(joint)
+    else:
+        return []
+    j = posed.joints[index]
+    order = j.rotation_order or posed.rotation_order
+    for axis_i, axis in enumerate("xyz"):
+        d = j.dofs[axis_i]
+        lo, hi = float(d.min), float(d.max)
+        if lo >= hi:
+            continue  # a locked DOF
+        # A quaternion is shown as the Euler angles of its joint's order, whose middle angle
+        # lies within ±90°: a slider beyond that would jump back once keyed.
+        bound = math.pi / 2 if j.quaternion and order[1] == axis else math.pi
+        lo, hi = max(lo, -bound), min(hi, bound) if math.isfinite(hi) else bound
+        make, preview = dof((index, axis), math.radians)
+        specs.append(DofSpec(f"rotate {axis}", math.degrees(float(d.value)), math.degrees(lo), math.degrees(hi),
+                             make, "°", m3.dof_channel_id(doc, asset, index, axis), math.radians, preview))
+    if j.translates or j.scales:
+        rest = m3.character(doc, asset).skeleton
+    if j.translates:
+        # The slider spans the skeleton's size either side of the rest position (fine enough
+        # to drag); a typed value may go anywhere.
+        reach = _reach(rest)
+        steps = _steps_for(2.0 * reach)
+        for axis_i, axis in enumerate("xyz"):
+            make, preview = dof((index, "t" + axis), float)
+            middle = float(rest.joints[index].translation[axis_i])
+            specs.append(DofSpec(f"translate {axis}", float(j.translation[axis_i]), middle - reach, middle + reach,
+                                 make, "", m3.dof_channel_id(doc, asset, index, "t" + axis), preview=preview,
+                                 steps=steps, decimals=_decimals(steps),
+                                 typed_range=(-TRANSLATION_LIMIT * reach, TRANSLATION_LIMIT * reach)))
+    if j.scales:
+        biggest = max(1.0, float(np.abs(rest.joints[index].scale).max()))
+        hi = 4.0 * biggest
+        lo = -hi if float(rest.joints[index].scale.min()) < 0 else 0.0
+        for axis_i, axis in enumerate("xyz"):
+            make, preview = dof((index, "s" + axis), float)
+            specs.append(DofSpec(f"scale {axis}", float(j.scale[axis_i]), lo, hi, make, "",
+                                 m3.dof_channel_id(doc, asset, index, "s" + axis), preview=preview, steps=100,
+                                 decimals=2))
+    return specs
+
+
+def _reach(skeleton: Any) -> float:
+    """A length that suits a skeleton's translation sliders: its rest size (1 for a
+    skeleton of one point)."""
+    world = np.asarray(skeleton.world_matrices(), dtype=np.float64)
+    reach = float(np.linalg.norm(np.ptp(world[:, :3, 3], axis=0))) if len(world) else 0.0
+    return reach if math.isfinite(reach) and reach > 1e-6 else 1.0
+
+
+def _steps_for(span: float) -> int:
+    """Slider steps per unit (a power of ten, at least 1) giving a slider over ``span``
+    units about 1000 to 10000 steps."""
+    return int(10 ** max(0, math.ceil(math.log10(1000.0 / span)))) if span > 0 else SLIDER_STEPS_PER_UNIT
+
+
+def _decimals(steps: int) -> int:
+    return max(2, round(math.log10(steps)))
 
 
 def joint_names(doc: Document, asset: str) -> list[tuple[str, int | None, bool]]:
@@ -201,11 +279,20 @@ def reset_pose_command(doc: Document, asset: str, time: float, gesture: object =
             cmd.do(doc)  # later keys build on this one; undone below
             commands.append(cmd)
     elif m3 is not None and kind == m3.ASSET_KIND:
-        for j, _name in enumerate(joint_names(doc, asset)):
-            for axis in "xyz":
-                cmd = m3.set_dof_command(doc, asset, j, axis, 0.0, time, gesture=gesture)
-                cmd.do(doc)
-                commands.append(cmd)
+        # Course skeletons reset to zero angles (CSE169's R); a glTF character to the
+        # file's rest pose, translations and scales included.
+        skel = m3.character(doc, asset).skeleton
+        rest_from_file = skel.dialect == "gltf"
+        values: dict[tuple[int | None, str | int], float] = {}
+        for j, joint in enumerate(skel.joints):
+            for a, axis in enumerate("xyz"):
+                values[(j, axis)] = float(joint.pose[a]) if rest_from_file else 0.0
+                if joint.translates:
+                    values[(j, "t" + axis)] = float(joint.translation[a])
+                if joint.scales:
+                    values[(j, "s" + axis)] = float(joint.scale[a])
+        if values:
+            return Macro("Reset Pose", [m3.set_dofs_command(doc, asset, values, time, gesture=gesture)])
     for cmd in reversed(commands):
         cmd.undo(doc)
     return Macro("Reset Pose", commands) if commands else None
@@ -250,16 +337,16 @@ class DofRow:
         self.label = QLabel(spec.label, panel)
         self.slider = QSlider(Qt.Orientation.Horizontal, panel)
         self.slider.setObjectName(f"dofSlider_{spec.label.replace(' ', '_')}")
-        self.slider.setRange(int(math.floor(spec.minimum * SLIDER_STEPS_PER_UNIT)),
-                             int(math.ceil(spec.maximum * SLIDER_STEPS_PER_UNIT)))
-        self.slider.setPageStep(10 * SLIDER_STEPS_PER_UNIT)
+        self.steps = spec.steps
+        self.slider.setRange(int(math.floor(spec.minimum * self.steps)), int(math.ceil(spec.maximum * self.steps)))
+        self.slider.setPageStep(10 * self.steps)
         self.spin = QDoubleSpinBox(panel)
         self.spin.setObjectName(f"dofSpin_{spec.label.replace(' ', '_')}")
-        self.spin.setDecimals(2)
-        self.spin.setRange(spec.minimum, spec.maximum)
+        self.spin.setDecimals(spec.decimals)
+        self.spin.setRange(*(spec.typed_range or (spec.minimum, spec.maximum)))
         self.spin.setSuffix(spec.suffix)
         self.spin.setKeyboardTracking(False)
-        self.spin.setSingleStep(1.0)
+        self.spin.setSingleStep(10.0 / self.steps)
         grid.addWidget(self.label, row, 0)
         grid.addWidget(self.slider, row, 1)
         grid.addWidget(self.spin, row, 2)
@@ -278,7 +365,7 @@ class DofRow:
         self.spec.value = value
         for w in (self.slider, self.spin):
             w.blockSignals(True)
-        self.slider.setValue(int(round(value * SLIDER_STEPS_PER_UNIT)))
+        self.slider.setValue(int(round(value * self.steps)))
         self.spin.setValue(value)
         for w in (self.slider, self.spin):
             w.blockSignals(False)
@@ -309,7 +396,7 @@ class DofRow:
     def _slider_changed(self, v: int) -> None:
         if self._aborted:
             return
-        value = v / SLIDER_STEPS_PER_UNIT
+        value = v / self.steps
         self.spin.blockSignals(True)
         self.spin.setValue(value)
         self.spin.blockSignals(False)
@@ -317,7 +404,7 @@ class DofRow:
 
     def _spin_changed(self, value: float) -> None:
         self.slider.blockSignals(True)
-        self.slider.setValue(int(round(value * SLIDER_STEPS_PER_UNIT)))
+        self.slider.setValue(int(round(value * self.steps)))
         self.slider.blockSignals(False)
         self.panel.key(self.spec, value, None)
 
@@ -351,12 +438,12 @@ class DofPanel(QWidget):
         layout.addLayout(buttons)
         layout.addStretch(1)
         self._editing = False
-        self._shown: tuple[str, str, tuple[str, ...]] | None = None
+        self._shown: tuple[str, str, tuple[tuple[str, float, float, int], ...]] | None = None
 
     def rebuild(self) -> None:
         asset, joint = self.ctx.selection
         specs = dof_specs(self.ctx.doc, asset, joint, self.ctx.time) if asset else []
-        key = (asset, joint, tuple(s.label for s in specs))
+        key = (asset, joint, tuple((s.label, s.minimum, s.maximum, s.steps) for s in specs))
         if key == self._shown and len(self.rows) == len(specs):
             for row, spec in zip(self.rows, specs):
                 row.spec = spec
@@ -394,7 +481,7 @@ class DofPanel(QWidget):
             doc = self.ctx.doc
             if spec.channel and not autokey(doc):
                 # Auto-key off: pose without keying, like a drag in the editors.
-                command: Command = PosePreview(doc, {spec.channel: spec.to_doc(value)}, self.ctx.time,
+                command: Command = PosePreview(doc, spec.pose_values(value, self.ctx.time), self.ctx.time,
                                                f"Pose {spec.label}", gesture)
             else:
                 command = spec.make(value, self.ctx.time, None)

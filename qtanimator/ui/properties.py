@@ -1,8 +1,9 @@
 """The properties dock: the selected joint and character, pendulum parameters, IK settings.
 
 Everything editable is a document parameter changed through a command (SetParameter, or
-``character2d.set_pendulum_preset`` for a preset), so it is undoable and saved with the
-project. Read-only facts (mass, inertia, pivot…) are shown as labels.
+``character2d.set_pendulum_preset`` for a preset), or an asset property changed through its
+own command (a BVH character's position convention, the clip a glTF character plays), so it
+is undoable and saved with the project. Read-only facts (mass, inertia, pivot…) are shown as labels.
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ from PySide6.QtWidgets import (
 from qtanimator.document.character2d import IK_DEFAULTS, ik_setting
 from qtanimator.document.commands import SetParameter
 from qtanimator.document.document import DocumentChange
+from qtanimator.ui.clip_picker import ClipCombo, clip_characters
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.joint_tree import c2d, c3d
 from qtanimator.ui.widgets import CheckedDoubleSpinBox, CheckedSpinBox
@@ -416,7 +418,45 @@ class PropertiesPanel(QWidget):
         else:
             form.addRow("Joints", QLabel(str(len(names))))
         self._bvh_positions_editor(form, asset)
+        self._clip_editor(form, asset)
+        self._rotation_mode_editor(form, asset)
         return group
+
+    def _rotation_mode_editor(self, form: QFormLayout, asset: str) -> None:
+        """How a 3D character's rotations are keyed (issue 21): quaternion curves (W X Y Z, as
+        a glTF file has them) or Euler curves (X Y Z angles); one undoable conversion."""
+        m3 = c3d()
+        doc = self.ctx.doc
+        if m3 is None or doc.assets[asset].kind != m3.ASSET_KIND:
+            return
+        combo = QComboBox()
+        combo.setObjectName("rotationMode")
+        combo.addItems(["quaternion", "euler"])
+        combo.setCurrentText(m3.rotation_mode(m3.character(doc, asset)))
+        combo.setToolTip("How rotations are keyed: quaternion curves (W, X, Y, Z; slerp between keys, as glTF "
+                         "files have them) or Euler curves (X, Y, Z angles). Switching converts the keys, "
+                         "exact at every key and frame.")
+
+        def push(value: str) -> None:
+            if value == m3.rotation_mode(m3.character(doc, asset)):
+                return
+            command = m3.set_rotation_mode_command(doc, asset, value)
+            # The change rebuilds this panel, deleting the combo: push after its signal returns.
+            QTimer.singleShot(0, lambda: self.ctx.push(command))
+
+        combo.currentTextChanged.connect(push)
+        form.addRow("Rotation keys", combo)
+        self.editors["rotation_mode"] = combo
+
+    def _clip_editor(self, form: QFormLayout, asset: str) -> None:
+        """The clip a glTF character plays (issue 21): one undoable command per choice. The
+        combo shows the document; a change of the asset rebuilds this panel."""
+        if asset not in clip_characters(self.ctx.doc):
+            return
+        combo = ClipCombo(self.ctx, asset, deferred=True)
+        combo.setObjectName("characterClip")
+        form.addRow("Clip", combo)
+        self.editors["clip"] = combo
 
     def _bvh_positions_editor(self, form: QFormLayout, asset: str) -> None:
         """A BVH character's position convention (issue 21): one undoable command per change."""

@@ -2,7 +2,8 @@
 
 ``install(window)`` adds a central tab "3D" holding a toolbar, the GL view (``viewport3d``:
 a widget holding a QOpenGLWindow in a window container, or a QOpenGLWidget, see
-:data:`DEFAULT_SURFACE`) and clip playback controls.
+:data:`DEFAULT_SURFACE`) and a bar below it with the clip a glTF character plays and the
+playback controls.
 
 Mouse: left click picks a joint (``ctx.select``); left drag orbits (on a live cloth it grabs
 the cloth, on a light's sphere it moves the light); middle drag or Shift+left pans; wheel or
@@ -61,6 +62,7 @@ from qtanimator.render.gl.renderer import (
     grid_scale_for,
 )
 from qtanimator.render.scene3d import scene_bounds, scene_items
+from qtanimator.ui.clip_picker import ClipPicker
 from qtanimator.ui.context import EditorContext
 
 #: Cloth pin moves per key press: metres and radians.
@@ -831,8 +833,9 @@ class Viewport3D(QWidget):
 
 
 class ClipControls(QWidget):
-    """Play / pause, speed, play mode and a progress bar over the document's frame range,
-    synced with ``ctx.frame`` (the timeline sees every frame it shows)."""
+    """The clip picker (:class:`~qtanimator.ui.clip_picker.ClipPicker`), play / pause, speed,
+    play mode and a progress bar over the document's frame range, synced with ``ctx.frame``
+    (the timeline sees every frame it shows)."""
 
     MODES = ("loop", "once", "ping-pong", "continue")
 
@@ -868,6 +871,12 @@ class ClipControls(QWidget):
         self.progress.setTextVisible(True)
         self.progress.setFormat("%p%")
         self.progress.mousePressEvent = self._seek_click  # type: ignore[method-assign]
+        # The clip the selected (or only) glTF character plays, before Play (the progress bar
+        # runs over its duration); hidden while no character has clips. Here rather than in the
+        # display bar above, which already fills the default window's width.
+        self.clip = ClipPicker(ctx, self)
+        self.clip.combo.setObjectName("viewportClip")
+        layout.addWidget(self.clip)
         layout.addWidget(self.play_button)
         layout.addWidget(QLabel("Speed", self))
         layout.addWidget(self.speed)
@@ -968,7 +977,7 @@ class ClipControls(QWidget):
 
 
 class ViewportPanel(QWidget):
-    """The "3D" tab: display toolbar, GL view, clip playback controls."""
+    """The "3D" tab: display toolbar, GL view, clip picker and playback controls."""
 
     def __init__(self, ctx: EditorContext, parent: QWidget | None = None, window: Any = None) -> None:
         super().__init__(parent)

@@ -177,3 +177,76 @@ def test_headless_render_of_a_falling_cloth_changes_frame_to_frame(qapp):
     assert all(len(r) > 30 for r in red)
     rows = [r[:, 0].mean() for r in red]
     assert rows[0] < rows[1] < rows[2]   # the cloth falls: it moves down the picture
+
+
+# ------------------------------------------------------------- mesh part colours
+def _two_part_doc(colors):
+    """A character of two flat squares side by side in y = 0, facing up (left: part 0,
+    right: part 1), lit by a white ambient light only, so each part shows its colour."""
+    from qtanimator.core.skeleton import Joint, Skeleton
+    from qtanimator.core.skinning import Skin, SkinBinding
+    from qtanimator.document.character3d import ASSET_KIND, Character3D, MeshPart
+    from qtanimator.document.commands import AddAsset
+    from qtanimator.document.document import Asset
+
+    square = np.array([[0, 0, -1], [1, 0, -1], [1, 0, 1], [0, 0, 1]], dtype=float)
+    positions = np.concatenate([square - [1.05, 0, 0], square + [0.05, 0, 0]])
+    triangles = np.array([[0, 2, 1], [0, 3, 2], [4, 6, 5], [4, 7, 6]])
+    n = len(positions)
+    skin = Skin(positions, triangles, SkinBinding(np.arange(n), np.zeros(n), np.ones(n), n, 1), np.eye(4)[None],
+                normals=np.tile([0.0, 1.0, 0.0], (n, 1)))
+    parts = [MeshPart("left", 0, 4, 0, 2, color=colors[0]), MeshPart("right", 4, 4, 2, 2, color=colors[1])]
+    runtime = Character3D(Skeleton([Joint("root")]), skin, parts=parts)
+    doc = _two_light_doc()
+    stack = UndoStack(doc)
+    for name in ("light1", "light2"):
+        stack.push(SetParameter(doc, f"{name}.intensity", 0.0))
+    stack.push(SetParameter(doc, "lights.ambient", [1.0, 1.0, 1.0]))
+    stack.push(AddAsset(Asset("squares", ASSET_KIND, "", {}), runtime, {}))
+    return doc
+
+
+SKIN_ONLY = ViewOptions(show_grid=False, show_lights=False, show_skeleton=False, background=(0, 0, 0, 1))
+
+
+@pytest.mark.parametrize("wireframe", [False, True])
+def test_mesh_parts_are_drawn_each_in_its_material_colour(qapp, wireframe):
+    from dataclasses import replace
+
+    from qtanimator.render.scene3d import display_color
+
+    doc = _two_part_doc([(1.0, 0.0, 0.0, 1.0), (0.0, 0.0, 1.0, 1.0)])
+    img = _render(doc, [], TOP, replace(SKIN_ONLY, wireframe=wireframe))[0].astype(int)
+    h, w = SIZE[1], SIZE[0]
+    left = img[h // 2 - 10: h // 2 + 10, w // 2 - 30: w // 2 - 10, :3].reshape(-1, 3)
+    right = img[h // 2 - 10: h // 2 + 10, w // 2 + 10: w // 2 + 30, :3].reshape(-1, 3)
+    red = (left[:, 0] > 200) & (left[:, 1] < 40) & (left[:, 2] < 40)
+    blue = (right[:, 2] > 200) & (right[:, 0] < 40) & (right[:, 1] < 40)
+    assert red.mean() > 0.8 and blue.mean() > 0.8
+    # the colours are the materials' (linear) base colours encoded for the screen
+    assert display_color((0.5, 0.2, 0.0, 0.3)) == pytest.approx((0.7354, 0.4845, 0.0, 1.0), abs=1e-4)
+
+
+def test_mesh_parts_of_one_colour_draw_the_skin_colour_as_before(qapp):
+    from qtanimator.render.gl.renderer import SKIN_COLOR
+    from qtanimator.render.scene3d import part_colors
+
+    doc = _two_part_doc([(0.1, 0.9, 0.1, 1.0), (0.1, 0.9, 0.1, 1.0)])
+    assert part_colors(doc.runtime["squares"], 4) == ()
+    img = _render(doc, [], TOP, SKIN_ONLY)[0].astype(int)
+    h, w = SIZE[1], SIZE[0]
+    for x in (w // 2 - 20, w // 2 + 20):
+        assert np.abs(img[h // 2, x, :3] - np.round(np.array(SKIN_COLOR[:3]) * 255)).max() <= 2
+
+
+def test_part_colours_cover_every_triangle():
+    from qtanimator.core.skeleton import Joint, Skeleton
+    from qtanimator.document.character3d import Character3D, MeshPart
+    from qtanimator.render.gl.renderer import SKIN_COLOR
+    from qtanimator.render.scene3d import display_color, part_colors
+
+    red, blue = (1.0, 0.0, 0.0, 1.0), (0.0, 0.0, 1.0, 1.0)
+    ch = Character3D(Skeleton([Joint("root")]), parts=[MeshPart("b", 0, 0, 5, 3, color=blue),
+                                                       MeshPart("a", 0, 0, 1, 2, color=red)])
+    assert part_colors(ch, 10) == ((0, 1, SKIN_COLOR), (1, 2, display_color(red)), (3, 2, SKIN_COLOR),
+                                   (5, 3, display_color(blue)), (8, 2, SKIN_COLOR))

@@ -99,6 +99,14 @@ class Mesh:
             GL.glDrawElements(self.mode, self.index_count, GL.GL_UNSIGNED_INT, None)
         GL.glBindVertexArray(0)
 
+    def draw_range(self, first: int, count: int) -> None:
+        """Draw ``count`` indices from index ``first`` (one part of the mesh)."""
+        if count <= 0:
+            return
+        GL.glBindVertexArray(self.vao)
+        GL.glDrawElements(self.mode, count, GL.GL_UNSIGNED_INT, ctypes.c_void_p(4 * first))
+        GL.glBindVertexArray(0)
+
     def delete(self) -> None:
         bufs = [b for b in (self.vbo_pos, self.vbo_nrm, self.vbo_col, self.ibo, self.vbo_inst) if b]
         GL.glDeleteBuffers(len(bufs), bufs)

@@ -81,6 +81,9 @@ class SkinDraw:
     pairs: np.ndarray             # (M, 2) joint index, weight
     matrices: np.ndarray          # (J, 4, 4) W_j · B_j⁻¹
     faceted: bool = False
+    #: (first triangle, triangle count, RGBA colour) of each part drawn in its own colour
+    #: (a character's meshes with their materials); empty: the whole skin in SKIN_COLOR.
+    parts: tuple[tuple[int, int, tuple[float, float, float, float]], ...] = ()
 
 
 @dataclass
@@ -355,7 +358,7 @@ class SceneRenderer:
         if mode >= 0 and opts.weight_asset is not None and opts.weight_asset != item.asset_id:
             mode = WEIGHTS_OFF
         p.set("u_weight_mode", mode)
-        self._draw_surface(mesh, opts.wireframe)
+        self._draw_surface(mesh, opts.wireframe, skin.parts)
 
     def skin_on_gpu(self, skin: SkinDraw, key: str = "_capture") -> tuple[np.ndarray, np.ndarray]:
         """Run the skinning vertex shader on every vertex and read back world positions and
@@ -394,13 +397,25 @@ class SceneRenderer:
         GL.glUseProgram(0)
         return arr[:, :3], arr[:, 3:]
 
-    def _draw_surface(self, mesh: Mesh, wireframe: bool) -> None:
+    def _draw_surface(self, mesh: Mesh, wireframe: bool,
+                      parts: Sequence[tuple[int, int, tuple[float, float, float, float]]] = ()) -> None:
+        """Draw a triangle mesh in the colour set, or each of its ``parts`` (first triangle,
+        triangle count, colour) in its own colour; a wireframe over it on request."""
         if wireframe:
             # Push the fill back so the wire drawn over it is not lost to z-fighting.
             GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
             GL.glPolygonOffset(1.0, 1.0)
-        mesh.draw()
-        self._count(mesh)
+        if parts:
+            p = self.program
+            assert p is not None
+            for first, count, color in parts:
+                p.set("u_color", np.asarray(color, dtype=float))
+                mesh.draw_range(3 * first, 3 * count)
+                self.stats["draw_calls"] += 1
+                self.stats["triangles"] += count
+        else:
+            mesh.draw()
+            self._count(mesh)
         if wireframe:
             GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
             self._wire(mesh)
