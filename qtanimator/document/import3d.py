@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import math
 import os
-import warnings
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,7 +43,6 @@ from qtanimator.document.character3d import (
     Character3D,
     _channel_ids,
     add_character3d_command,
-    channel_ids,
     character,
     clip_range_command,
     load_anim_command,
@@ -53,9 +51,10 @@ from qtanimator.document.character3d import (
 from qtanimator.document.commands import AddAsset, Command, Macro, SetParameter
 from qtanimator.document.document import Asset, Document
 from qtanimator.document.gltf_character import GLTF_ROTATION_ORDER, character_from_gltf
+from qtanimator.document.gltf_export import character_scene
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.errors import FormatError
-from qtanimator.formats.gltf import CharacterExport, GltfExportWarning, export_character_glb, import_gltf
+from qtanimator.formats.gltf import CharacterExport, export_glb, import_gltf
 from qtanimator.formats.skel import load_skel
 from qtanimator.formats.skin import load_skin
 
@@ -303,7 +302,8 @@ def gltf_import(doc: Document, path: str | os.PathLike[str]) -> Import:
     notes = [f"{len(ch.parts)} meshes ({nv} vertices), {len(ch.skeleton.joints)} joints."]
     if ch.clips:
         listed = ", ".join(f"{c.name} ({c.end - c.start:.3g} s)" for c in ch.clips)
-        notes.append(f"{len(ch.clips)} clips: {listed}; pick one in Properties or the 3D toolbar.")
+        notes.append(f"{len(ch.clips)} clips: {listed}; pick one in Properties or in the Clip list under the "
+                     "3D view.")
     notes += mapping.notes
     if not ch.clips:
         return Import(add, aid, notes)
@@ -338,23 +338,13 @@ def import_file(doc: Document, path: str | os.PathLike[str], selected: str | Non
 
 # ------------------------------------------------------------------------- export
 def export_gltf(doc: Document, asset_id: str, path: str | os.PathLike[str]) -> tuple[CharacterExport, list[str]]:
-    """Write a 3D character and its channels to ``.glb`` over the document's frame range at
-    its fps. Returns the export and the warnings it gave (:class:`GltfExportWarning`).
+    """Write a 3D character to ``.glb``: every mesh, every clip (a character without clips: its
+    channels over the document's frame range at its fps) and the rest pose of its file (see
+    :mod:`qtanimator.document.gltf_export`). Returns the export and messages for the user
+    (keys that had to be sampled, weights renormalised).
 
     Raises ValueError when the character has no skin or mesh; OSError when writing fails.
     """
-    ch = character(doc, asset_id)
-    if ch.skin is None:
-        raise ValueError(f"3D character {asset_id!r} has no skin or mesh to export.")
-    chans: list[Channel | None] = [doc.channels.get(cid) for cid in channel_ids(doc, asset_id)]
-    first, last = doc.frame_range
-    start, end = doc.frame_to_time(first), doc.frame_to_time(last)
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", GltfExportWarning)
-        result = export_character_glb(path, ch.skeleton, ch.skin, chans, start, max(start, end), doc.fps,
-                                      name=asset_id)
-    messages = [str(w.message) for w in caught if issubclass(w.category, GltfExportWarning)]
-    for w in caught:
-        if not issubclass(w.category, GltfExportWarning):
-            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    result, messages = character_scene(doc, asset_id)
+    export_glb(path, result.scene)
     return result, messages

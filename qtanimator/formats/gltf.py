@@ -11,15 +11,13 @@ the skinned mesh node's own transform is ignored and joint j moves vertices by
 
 Export: :func:`export_glb` writes a :class:`GltfScene` (one buffer, one buffer view per
 accessor, 4-byte aligned, min / max on every accessor, the JSON chunk padded with spaces
-and the BIN chunk with zeros). :func:`export_character_glb` turns a
-:class:`~qtanimator.core.skeleton.Skeleton`, a :class:`~qtanimator.core.skinning.Skin` and
-``.anim``-layout channels into such a scene: joints become nodes, the skin keeps its
-inverse bind matrices, each vertex keeps its strongest four influences (renormalised, with a
-:class:`GltfExportWarning` when that visibly changes the animated shape), and the animation
-is sampled at ``fps`` with LINEAR or CUBICSPLINE interpolation. Exported time 0 is the
-clip's ``start``. glTF's cubic spline is Hermite and has no handle lengths, so a channel
-with weighted tangents (issue 13) is sampled like every other one, and a
-:class:`GltfExportWarning` names it.
+and the BIN chunk with zeros). A whole character (every mesh and clip, keys as they are) is
+turned into such a scene by :mod:`qtanimator.document.gltf_export`.
+:func:`export_character_glb` is the older path for one skeleton, one skin and ``.anim``-layout
+channels: joints become nodes, each vertex keeps its strongest four influences (renormalised,
+with a :class:`GltfExportWarning` when that visibly changes the animated shape), and the
+animation is sampled at ``fps`` with LINEAR or CUBICSPLINE interpolation, time 0 at
+``start``; a channel with weighted tangents (issue 13) is sampled and named in a warning.
 
 Every malformed file raises :class:`~qtanimator.formats.FormatError`.
 """
@@ -989,7 +987,7 @@ class _Writer:
         self.size = 0
         self.views: list[dict[str, Any]] = []
         self.accessors: list[dict[str, Any]] = []
-        self._dedup: dict[tuple[bytes, str, int | None], int] = {}
+        self._dedup: dict[tuple[bytes, int, str, int | None, bool], int] = {}
 
     def view(self, data: bytes, target: int | None = None) -> int:
         pad = (-self.size) % 4
@@ -1014,7 +1012,7 @@ class _Writer:
         if len(a) == 0:
             raise ValueError("cannot export an empty accessor")
         data = a.tobytes()
-        key = (data, kind, target)
+        key = (data, ctype, kind, target, normalized)
         if key in self._dedup:
             return self._dedup[key]
         acc: dict[str, Any] = {"bufferView": self.view(data, target), "componentType": ctype,
@@ -1175,14 +1173,16 @@ def export_glb(path: str | os.PathLike[str], scene: GltfScene) -> None:
 # ------------------------------------------------------------------ characters
 @dataclass
 class CharacterExport:
-    """What :func:`export_character_glb` wrote and what it had to change."""
+    """What :func:`export_character_glb` (or :func:`qtanimator.document.gltf_export.character_scene`,
+    which keeps every influence) wrote and what it had to change."""
 
     scene: GltfScene
+    #: the sample times (the whole-character export: every time of its first animation)
     times: FloatArray
     #: vertices that had more influences than the export keeps
     dropped_vertices: IntArray
-    #: largest vertex displacement that dropping caused over the sampled frames,
-    #: relative to the bind mesh's bounding-box diagonal
+    #: largest vertex displacement that dropping (the whole-character export: dividing the
+    #: weights by their sums) caused, relative to the mesh's bounding-box diagonal
     max_relative_error: float
     joint_nodes: list[int]
     mesh_node: int
@@ -1267,6 +1267,12 @@ def _with_key_times(grid: FloatArray, channels: Sequence[Channel], start: float,
         near |= np.abs(keys[i - 1] - grid) <= tolerance
     merged: FloatArray = np.union1d(grid[~near], keys)
     return merged
+
+
+def sample_times(start: float, end: float, fps: float, channels: Sequence[Channel] = ()) -> FloatArray:
+    """Times from ``start`` to ``end`` (both included) every ``1 / fps`` seconds, plus every
+    key time of ``channels`` (cycled keys included) inside that range; what the exports sample."""
+    return _with_key_times(_sample_times(start, end, fps), channels, start, end)
 
 
 def _channel_values(skeleton: Skeleton, channels: Sequence[Channel | None], times: FloatArray,

@@ -71,7 +71,7 @@ def _export_target(window: Any) -> str | None:
 def export_gltf_to(window: Any, path: str | os.PathLike[str], asset_id: str | None = None) -> bool:
     """Export a 3D character (the selected or only one by default) to ``path`` as ``.glb``.
 
-    Warnings (influences dropped) are shown as a message; errors through ``show_error``.
+    Messages (weights normalised, keys sampled) are shown as a message; errors through ``show_error``.
     """
     aid = asset_id or _export_target(window)
     if aid is None:

@@ -147,11 +147,12 @@ def test_export_gltf_action_and_round_trip(window, shared_data, tmp_path, dialog
     assert all(title == "glTF export" for title, _ in dialog_log)
 
 
-def test_export_gltf_warns_when_influences_are_dropped(window, shared_data, tmp_path, dialog_log):
+def test_export_gltf_shows_its_messages(window, shared_data, tmp_path, dialog_log):
     from qtanimator.ui.import3d import export_gltf_to
 
     _before, aid = _opened(window, shared_data / "mit6837" / "Model1.skel", dialog_log)
-    # pose a joint so that the dropped influences show
+    # MIT weights do not sum to 1: the export divides them by their sum and says how far that
+    # moves the mesh (every influence is kept)
     from qtanimator.document.character3d import set_dofs_command
 
     window.ctx.push(set_dofs_command(window.doc, aid, {(j, "x"): 0.8 for j in range(1, 10)}, 0.0))
@@ -159,7 +160,7 @@ def test_export_gltf_warns_when_influences_are_dropped(window, shared_data, tmp_
     assert export_gltf_to(window, tmp_path / "m.glb")
     assert (tmp_path / "m.glb").is_file()
     assert window.last_export_warnings == [t for title, t in dialog_log if title == "glTF export"]
-    assert window.last_export_warnings, "MIT vertices have more than 4 influences"
+    assert window.last_export_warnings and any("weight" in w for w in window.last_export_warnings)
 
 
 def test_export_gltf_errors(window, shared_data, tmp_path, dialog_log):
