@@ -585,3 +585,43 @@ def test_the_view_multisamples_on_a_gpu_but_not_on_a_software_rasteriser(window,
     assert not glmod.is_software_renderer("NVIDIA GeForce RTX 3060/PCIe/SSE2")
     monkeypatch.setenv("QTANIMATOR_VIEW_SAMPLES", "8")
     assert glmod.view_samples() == 8
+
+
+def test_right_drag_ik_on_a_gltf_character_below_its_placement_keys_quaternions(window, qtbot, shared_data):
+    """CesiumMan hangs below a Z-up to Y-up node (its placement) and its joints are keyed as
+    quaternions: the drag picks the joint where it is drawn, moves it towards the mouse, and
+    keys the four quaternion channels of the chain in one undo step."""
+    from qtanimator.document.character3d import character, pose_skeleton
+    from qtanimator.document.import3d import import_file
+
+    imp = import_file(window.doc, shared_data / "gltf" / "CesiumMan.glb")
+    window.ctx.push(imp.command)
+    aid = imp.asset_id
+    view = window.viewport3d
+    view.options.show_skin = False
+    skel = character(window.doc, aid).skeleton
+    rest = skel.world_matrices()[:, :3, 3]
+    centre = 0.5 * (rest.min(axis=0) + rest.max(axis=0))
+    view.camera = OrbitCamera(azimuth=0.0, inclination=0.0, distance=4.0, target=centre)
+    view._framed_once = True
+    window.ctx.set_frame(30)
+    keys = skel.joint_keys()
+    # the joint farthest from the root along the chain that is furthest from the centre: a hand
+    joint = int(np.argmax(np.linalg.norm(rest - centre, axis=1) * (np.array(skel.depths) >= 3)))
+    p0 = pose_skeleton(window.doc, aid, window.ctx.time).world_matrices()[joint, :3, 3]
+    w, h = view.width(), view.height()
+    start = view.camera.project(p0, w, h)[0]
+    a = QPoint(int(round(start[0])), int(round(start[1])))
+    steps = window.ctx.undo_stack.count()
+    qtbot.mousePress(view, Qt.MouseButton.RightButton, pos=a)
+    for k in range(1, 5):
+        qtbot.mouseMove(view, a + QPoint(0, -8 * k))
+    qtbot.mouseRelease(view, Qt.MouseButton.RightButton, pos=a + QPoint(0, -32))
+    assert window.ctx.undo_stack.count() == steps + 1
+    p1 = pose_skeleton(window.doc, aid, window.ctx.time).world_matrices()[joint, :3, 3]
+    moved = view.camera.project(p1, w, h)[0]
+    assert moved[1] < start[1] - 10  # up the screen, towards the mouse
+    parent = skel.joints[joint].parent
+    qw = window.doc.channels[f"{aid}/{keys[parent]}/qw"]
+    assert qw.key_index(window.ctx.time) is not None
+    assert f"{aid}/{keys[parent]}/rx" not in window.doc.channels
