@@ -3,7 +3,8 @@
 At import time we try to start ``Xvfb -displayfd``. When it starts, every Qt test runs on
 the ``xcb`` platform on that private display, so QOpenGLWidget gets a real Mesa (llvmpipe)
 context. When it cannot start, widgets run on the ``offscreen`` platform and the tests
-marked ``gl`` are skipped with the reason.
+marked ``gl`` are skipped with the reason; in CI (``CI=true``) they fail instead, as do the
+tests that need ``../shared/data`` when it is missing (see ``tests/needs.py``).
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ import tempfile
 from pathlib import Path
 
 import pytest
+from needs import missing
 
 from qtanimator.render.xvfb import start_private_xvfb
 
@@ -52,20 +54,17 @@ def _configure_qt() -> None:
 _configure_qt()
 
 
-def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
-    if os.environ.get("QTANIMATOR_TEST_GL"):
-        return
-    skip = pytest.mark.skip(reason=f"no OpenGL context: {_xvfb_reason}")
-    for item in items:
-        if "gl" in item.keywords:
-            item.add_marker(skip)
+def pytest_runtest_setup(item: pytest.Item) -> None:
+    """A test marked ``gl`` without an OpenGL context: skipped, or failed in CI."""
+    if "gl" in item.keywords and not os.environ.get("QTANIMATOR_TEST_GL"):
+        missing(f"no OpenGL context: {_xvfb_reason}")
 
 
 @pytest.fixture(scope="session")
 def shared_data() -> Path:
-    """The real public sample files; tests using this skip when they are absent."""
+    """The real public sample files; tests using this skip when they are absent (fail in CI)."""
     if not SHARED_DATA.is_dir():
-        pytest.skip(f"shared sample data not found at {SHARED_DATA}")
+        missing(f"shared sample data not found at {SHARED_DATA}")
     return SHARED_DATA
 
 

@@ -11,6 +11,7 @@ from pathlib import Path
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from needs import missing
 
 from qtanimator.core.channel import Channel, Interpolation, Key, Tangent
 from qtanimator.document import (
@@ -306,7 +307,7 @@ def test_the_demo_project_round_trips(tmp_path):
 
     demo = demo_project()
     if not demo.exists():
-        pytest.skip("no bundled demo project")
+        missing("no bundled demo project")
     doc = open_document(demo)
     save_document(doc, tmp_path / "x.qtanim")
     again = open_document(tmp_path / "x.qtanim")
