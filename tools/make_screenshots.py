@@ -15,6 +15,7 @@ Shots (``docs/images/NAME.png``):
 * ``main_window`` — the whole window on the 2D rig editor after an IK drag;
 * ``curve_editor`` — the curve editor with keys selected and their tangent handles;
 * ``viewport_3d`` — the 3D tab: the waving arm, the flag in the wind, the two lights;
+* ``viewport_shadow`` — the 3D tab with the floor shadow, the axes (X) and View ▸ 3D Camera…;
 * ``joint_tree`` — the Joints dock with the 3D arm's elbow selected and its DOF sliders;
 * ``pendulum_properties`` — the Properties dock for Pip's pendulum lantern;
 * ``cloth_panel`` — the Cloth dock with the flag;
@@ -39,8 +40,8 @@ REPO = Path(__file__).resolve().parents[1]
 OUT = REPO / "docs" / "images"
 MAX_WIDTH = 1400
 WINDOW_SIZE = (1400, 900)
-SHOTS = ("main_window", "curve_editor", "viewport_3d", "joint_tree", "pendulum_properties", "cloth_panel",
-         "export_dialog", "gltf_clips")
+SHOTS = ("main_window", "curve_editor", "viewport_3d", "viewport_shadow", "joint_tree", "pendulum_properties",
+         "cloth_panel", "export_dialog", "gltf_clips")
 
 
 # ------------------------------------------------------------------ display
@@ -263,6 +264,39 @@ class Shooter:
         self.grab_window("viewport_3d")
         editor.tree.set_checked(editor.tree.channel_ids(), True)
 
+    def viewport_shadow(self) -> None:
+        """The 3D tab with the Shadow box ticked (a real click), the axes shown with a real X
+        key press, and the camera fields open over the view's corner; the screen is grabbed so
+        that the camera window is in the picture."""
+        from PySide6.QtCore import QPoint, Qt
+        from PySide6.QtGui import QAction
+        from PySide6.QtTest import QTest
+
+        self.tab("3D")
+        self.ctx.set_frame(90.0)
+        self.ctx.select("", "")
+        panel = self.window.viewport_panel
+        view = panel.view
+        view.frame_selection()
+        view.set_camera(distance=view.camera.distance * 0.95, azimuth=12.0, inclination=32.0)
+        if not panel.shadow.isChecked():
+            QTest.mouseClick(panel.shadow, Qt.MouseButton.LeftButton)
+        view.setFocus()
+        QTest.keyClick(view, Qt.Key.Key_X)
+        self.window.findChild(QAction, "actionCamera3d").trigger()
+        dialog = self.window.camera_dialog
+        settle(self.app, 0.3)
+        corner = view.mapToGlobal(QPoint(view.width() - dialog.frameGeometry().width() - 8, 8))
+        dialog.move(corner)
+        self._settle_and_grab(panel)   # the cloth simulated, the view repainted
+        settle(self.app, 0.6)
+        origin = panel.mapToGlobal(QPoint(0, 0))
+        shot = self.window.screen().grabWindow(0, origin.x(), origin.y(), panel.width(), panel.height())
+        dialog.close()
+        QTest.keyClick(view, Qt.Key.Key_X)
+        QTest.mouseClick(panel.shadow, Qt.MouseButton.LeftButton)
+        save_png(shot, self.out / "viewport_shadow.png")
+
     def joint_tree(self) -> None:
         self.tab("3D")
         self.ctx.select("arm", "elbow")
@@ -472,8 +506,8 @@ def main(argv: list[str] | None = None) -> int:
     os.environ["QTANIMATOR_SETTINGS_DIR"] = settings_dir
     try:
         shooter = Shooter(ns.out)
-        order = ["main_window", "pendulum_properties", "curve_editor", "viewport_3d", "joint_tree", "cloth_panel",
-                 "export_dialog", "gltf_clips"]  # gltf_clips last: it replaces the demo
+        order = ["main_window", "pendulum_properties", "curve_editor", "viewport_3d", "viewport_shadow", "joint_tree",
+                 "cloth_panel", "export_dialog", "gltf_clips"]  # gltf_clips last: it replaces the demo
         for name in order:
             if ns.only and name not in ns.only:
                 continue

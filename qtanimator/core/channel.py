@@ -3,11 +3,13 @@
 The semantics are fixed by ARCHITECTURE section 4 and notes/cse169-formats.md section 8:
 
 * a key is ``(time, value, in, out)``; each side has a rule ``flat | linear | smooth |
-  clamped`` or a fixed slope (value per second);
+  clamped | centripetal | chordal | tcb`` or a fixed slope (value per second);
 * the span after key ``i`` is cubic Hermite with ``v0 = Δt·out[i]``, ``v1 = Δt·in[i+1]``,
   or linear, or constant (stepped);
 * before the first key and after the last one the pre / post extrapolation applies, with
-  strict boundaries and the floor convention at exact period multiples;
+  strict boundaries for values and the floor convention at exact period multiples; the
+  derivatives *at* the first and last key are the extrapolation's (the CMU handout: at and
+  outside the end knots a constant spline's derivatives are 0);
 * a key may carry handle lengths (weighted tangents, issue 13): a cubic span with a weight
   on either side is a cubic Bézier in time and value, evaluated exactly by solving for its
   parameter (:mod:`qtanimator.core.bezier`); spans without weights are Hermite as above.
@@ -45,6 +47,13 @@ class Tangent(StrEnum):
     SMOOTH = "smooth"
     CLAMPED = "clamped"
     FIXED = "fixed"
+    #: Catmull-Rom over the keys as points ``(time, value)`` with knot spacing ``|Δp|^½``
+    #: (Barry–Goldman); the slope is the curve's ``dv/dt`` at the key.
+    CENTRIPETAL = "centripetal"
+    #: The same with knot spacing ``|Δp|`` (chord length).
+    CHORDAL = "chordal"
+    #: Kochanek–Bartels: the key's tension, continuity and bias shape its in and out slopes.
+    TCB = "tcb"
 
 
 class Extrapolation(StrEnum):
@@ -88,6 +97,9 @@ class Key:
     ``wa + wb > Δt`` evaluation scales both down in proportion so that they fill the span
     (time stays monotonic, as Blender clamps); the key keeps the lengths the user set.
     Weights on linear and stepped spans are kept but have no effect.
+
+    ``tension`` / ``continuity`` / ``bias`` are the Kochanek–Bartels parameters (finite,
+    usually in −1…1, default 0) used by a side whose rule is TCB; other rules ignore them.
     """
 
     time: float
@@ -100,6 +112,9 @@ class Key:
     broken: bool = False
     in_weight: float | None = None
     out_weight: float | None = None
+    tension: float = 0.0
+    continuity: float = 0.0
+    bias: float = 0.0
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.time) and math.isfinite(self.value)):
@@ -114,6 +129,10 @@ class Key:
             object.__setattr__(self, "in_weight", _weight(self.in_weight))
         if self.out_weight is not None:
             object.__setattr__(self, "out_weight", _weight(self.out_weight))
+        for name in _TCB_FIELDS:
+            v = getattr(self, name)
+            if v.__class__ is not float or not math.isfinite(v):
+                object.__setattr__(self, name, _tcb_parameter(name, v))
 
     @classmethod
     def make(cls, time: float, value: float, tan_in: Tangent | str | float = Tangent.SMOOTH,
@@ -142,7 +161,8 @@ class Key:
             raise ValueError("key slopes must be finite")
         rule = Tangent.FIXED if fixed else Tangent.LINEAR
         base = {"in_tangent": rule, "out_tangent": rule, "interpolation": Interpolation(interpolation),
-                "broken": False, "in_weight": None, "out_weight": None}
+                "broken": False, "in_weight": None, "out_weight": None, "tension": 0.0, "continuity": 0.0,
+                "bias": 0.0}
         out: list[Key] = []
         new = object.__new__
         for ti, vi, ai, bi in zip(t.tolist(), v.tolist(), a.tolist(), b.tolist()):
@@ -169,6 +189,13 @@ class Key:
             d["in_weight"] = self.in_weight
         if self.out_weight is not None:
             d["out_weight"] = self.out_weight
+        # Kochanek–Bartels parameters only when set: keys without them write what they always did.
+        if self.tension:
+            d["tension"] = self.tension
+        if self.continuity:
+            d["continuity"] = self.continuity
+        if self.bias:
+            d["bias"] = self.bias
         return d
 
     @classmethod
@@ -176,7 +203,9 @@ class Key:
         return cls.make(d["t"], d["v"], d.get("in", "smooth"), d.get("out", "smooth"),
                         interpolation=Interpolation(d.get("interp", "cubic")),
                         broken=bool(d.get("broken", False)),
-                        in_weight=d.get("in_weight"), out_weight=d.get("out_weight"))
+                        in_weight=d.get("in_weight"), out_weight=d.get("out_weight"),
+                        tension=d.get("tension", 0.0), continuity=d.get("continuity", 0.0),
+                        bias=d.get("bias", 0.0))
 
 
 def _weight(w: Any) -> float:
@@ -186,6 +215,19 @@ def _weight(w: Any) -> float:
     value = float(w)
     if not (math.isfinite(value) and value > 0.0):
         raise ValueError(f"a tangent weight must be finite and positive, got {w!r}")
+    return value
+
+
+_TCB_FIELDS = ("tension", "continuity", "bias")
+
+
+def _tcb_parameter(name: str, v: Any) -> float:
+    """A Kochanek–Bartels parameter: a finite number (not a bool, not a text)."""
+    if isinstance(v, (bool, str, bytes)) or not isinstance(v, numbers.Real):
+        raise TypeError(f"a key's {name} must be a number, got {v!r}")
+    value = float(v)
+    if not math.isfinite(value):
+        raise ValueError(f"a key's {name} must be finite, got {v!r}")
     return value
 
 
@@ -398,11 +440,13 @@ class Channel:
                 keys[j] = replace(keys[j], in_tangent=Tangent.FIXED, out_tangent=Tangent.FIXED,
                                   in_slope=float(c.slope_in[j]), out_slope=float(c.slope_out[j]))
 
-            def on_span(t: FloatArray, deriv: int, i: int = int(i), tb: float = tb) -> FloatArray:
-                # This span's own curve, also at its end (the channel gives the next span's there).
+            def on_span(t: FloatArray, deriv: int, i: int = int(i), ta: float = ta, tb: float = tb) -> FloatArray:
+                # This span's own curve, also at its ends (the channel gives the next span's
+                # derivatives at tb, and the extrapolation's at the first and last key).
                 res: FloatArray = self.evaluate(t, deriv)
+                start = c.values[i] if deriv == 0 else c.slope_out[i]
                 end = c.values[i + 1] if deriv == 0 else c.slope_in[i + 1]
-                return np.where(t == tb, end, res)
+                return np.where(t == tb, end, np.where(t == ta, start, res))
 
             cuts: list[float] = []
             pieces = np.array([[ta, tb]])
@@ -469,14 +513,15 @@ class Channel:
             return math.nan if math.isnan(t) else (c.p0 if deriv == 0 else 0.0)
         w = t - c.t0
         period = c.period
-        if 0.0 <= w <= period:
+        if 0.0 <= w <= period and (deriv == 0 or 0.0 < w < period):
             i = bisect_right(c.rel_l, w) - 1
             if c.bez_l is not None and (bz := c.bez_l[i]) is not None:
                 return _bezier(bz, w - c.rel_l[i], deriv)
             return _poly(c.coef_l[i], w - c.rel_l[i], deriv)
         if math.isnan(w):
             return math.nan
-        before = w < 0.0
+        # Outside, or a derivative at the first / last key: those belong to the extrapolation.
+        before = w <= 0.0
         mode = self.pre if before else self.post
         if mode is Extrapolation.CONSTANT:
             return (c.p0 if before else c.p1) if deriv == 0 else 0.0
@@ -487,7 +532,8 @@ class Channel:
             return slope if deriv == 1 else 0.0
         if not math.isfinite(w):
             return math.nan  # an infinite time has no place in a period
-        k = float(math.floor(w / period))
+        # At the first key itself, the pre side is the end of the previous period (k = −1).
+        k = -1.0 if w == 0.0 else float(math.floor(w / period))
         u = min(max(w - k * period, 0.0), period)
         odd = mode is Extrapolation.BOUNCE and math.fmod(k, 2.0) != 0.0
         if odd:
@@ -514,8 +560,10 @@ class Channel:
             return res
         period = c.period
         w = t - c.t0
-        if w.size and 0.0 <= w.min() and w.max() <= period:
-            # Fast path: every sample lies between the first and the last key.
+        if w.size and ((0.0 <= w.min() and w.max() <= period) if deriv == 0 else
+                       (0.0 < w.min() and w.max() < period)):
+            # Fast path: every sample lies between the first and the last key (strictly for a
+            # derivative: the derivatives at the end keys are the extrapolation's).
             i = np.searchsorted(c.rel, w, side="right")
             i -= 1
             return _span_array(c, i, w - c.rel.take(i), deriv)
@@ -527,19 +575,29 @@ class Channel:
         period = c.period
         pre_p = pre in _PERIODIC
         post_p = post in _PERIODIC
+        # Values: the keys are inside (strict boundaries). Derivatives: the first and the last
+        # key belong to the pre / post extrapolation (the handout's "at and outside the end knots").
+        before = w <= 0.0 if deriv else w < 0.0
+        after = w >= period if deriv else w > period
         k: FloatArray | None = None
         odd: npt.NDArray[np.bool_] | None = None
         if pre_p or post_p:
-            # k = floor((t - t0) / d) outside the keys, 0 inside and on non-periodic sides.
+            # k = floor((t - t0) / d) outside the keys, 0 inside and on non-periodic sides;
+            # for a derivative at the first key itself k = −1 (the end of the period before).
             q = np.floor(w / period)
             if pre_p and post_p:
                 # floor gives 0 inside, except 1 at w == d exactly (the last key itself).
                 k = q
-                np.copyto(k, 0.0, where=w == period)
+                if deriv:
+                    np.copyto(k, -1.0, where=w == 0.0)
+                else:
+                    np.copyto(k, 0.0, where=w == period)
             elif pre_p:
                 k = np.minimum(q, 0.0)
+                if deriv:
+                    np.copyto(k, -1.0, where=w == 0.0)
             else:
-                k = np.where(w > period, q, 0.0)
+                k = np.where(after, q, 0.0)
             u = k * period
             np.subtract(w, u, out=u)
             if pre is Extrapolation.BOUNCE or post is Extrapolation.BOUNCE:
@@ -573,13 +631,13 @@ class Channel:
                 fill = c.p0 + c.in0 * w if deriv == 0 else (c.in0 if deriv == 1 else 0.0)
             else:
                 fill = c.p0 if deriv == 0 else 0.0
-            res = np.where(w < 0.0, fill, res)
+            res = np.where(before, fill, res)
         if not post_p:
             if post is Extrapolation.LINEAR:
                 fill = c.p1 + c.out1 * (t - c.t1) if deriv == 0 else (c.out1 if deriv == 1 else 0.0)
             else:
                 fill = c.p1 if deriv == 0 else 0.0
-            res = np.where(w > period, fill, res)
+            res = np.where(after, fill, res)
         return res
 
     def _compile(self) -> _Compiled:
@@ -651,7 +709,9 @@ class Channel:
         otherwise; ``interp`` is left out when every span is cubic, ``broken`` when no key
         is broken and a weight column when no key has that weight (a key without one is
         ``null`` in a per-key column), as in the key form. So a channel without weights
-        writes exactly what it wrote before weights existed.
+        writes exactly what it wrote before weights existed. The Kochanek–Bartels columns
+        ``tension`` / ``continuity`` / ``bias`` are written likewise only when some key has
+        a non-zero one (0 for the others in a per-key column).
         """
         d: dict[str, Any] = {"pre": self.pre.value, "post": self.post.value}
         if not columns:
@@ -671,6 +731,10 @@ class Channel:
                 weights = [getattr(k, side) for k in keys]
                 if any(w is not None for w in weights):
                     d[side] = _shared(weights)
+            for name in _TCB_FIELDS:
+                params = [getattr(k, name) for k in keys]
+                if any(params):
+                    d[name] = _shared(params)
         # Plain floats (a key made in code may hold an int): what loads back saves the same.
         d["times"] = [float(k.time) for k in keys]
         d["values"] = [float(k.value) for k in keys]
@@ -693,21 +757,26 @@ class Channel:
             raise ValueError(f"{n} times but {len(values)} values")
         columns: dict[str, Any] = {name: d.get(name, default) for name, default in
                    (("in", "smooth"), ("out", "smooth"), ("interp", "cubic"), ("broken", False),
-                    ("in_weight", None), ("out_weight", None))}
+                    ("in_weight", None), ("out_weight", None), ("tension", None),
+                    ("continuity", None), ("bias", None))}
         for name, column in columns.items():
             if isinstance(column, list) and len(column) != n:
                 raise ValueError(f"\"{name}\" has {len(column)} entries for {n} keys")
-        ins, outs, interps, brokens, in_ws, out_ws = columns.values()
+        ins, outs, interps, brokens, in_ws, out_ws, tens, conts, biases = columns.values()
         if not all(isinstance(b, bool) for b in (brokens if isinstance(brokens, list) else [brokens])):
             raise TypeError("\"broken\" must be true or false")
         if not isinstance(brokens, list):
             brokens = itertools.repeat(brokens, n)
-        if in_ws is not None or out_ws is not None:
-            # Weights are rare: such a channel takes the per-key path.
-            ins, outs, interps, in_ws, out_ws = (c if isinstance(c, list) else itertools.repeat(c, n)
-                                                 for c in (ins, outs, interps, in_ws, out_ws))
-            return cls([Key.make(t, v, i, o, interpolation=Interpolation(m), broken=b, in_weight=iw, out_weight=ow)
-                        for t, v, i, o, m, b, iw, ow in zip(times, values, ins, outs, interps, brokens, in_ws, out_ws)],
+        if in_ws is not None or out_ws is not None or any(c is not None for c in (tens, conts, biases)):
+            # Weights and Kochanek–Bartels parameters are rare: such a channel takes the per-key path.
+            tens, conts, biases = (0.0 if c is None else c for c in (tens, conts, biases))
+            ins, outs, interps, in_ws, out_ws, tens, conts, biases = (
+                c if isinstance(c, list) else itertools.repeat(c, n)
+                for c in (ins, outs, interps, in_ws, out_ws, tens, conts, biases))
+            return cls([Key.make(t, v, i, o, interpolation=Interpolation(m), broken=b, in_weight=iw, out_weight=ow,
+                                 tension=tt, continuity=cc, bias=bb)
+                        for t, v, i, o, m, b, iw, ow, tt, cc, bb in zip(times, values, ins, outs, interps, brokens,
+                                                                       in_ws, out_ws, tens, conts, biases)],
                        pre, post)
         if not any(isinstance(c, list) for c in (ins, outs, interps)):
             # Every key shares its rules: resolve them once (a long channel loads faster).
@@ -862,7 +931,8 @@ def _resolve_slopes(keys: Sequence[Key], times: FloatArray,
     clamped = smooth.copy()
     if n > 2:
         lo, hi = secant[:-1], secant[1:]
-        extremum = lo * hi <= 0.0
+        with np.errstate(over="ignore"):  # huge secants: the product's sign is still right
+            extremum = lo * hi <= 0.0
         limit = 3.0 * np.minimum(np.abs(lo), np.abs(hi))
         inner = np.clip(smooth[1:-1], -limit, limit)
         clamped[1:-1] = np.where(extremum, 0.0, inner)
@@ -870,21 +940,96 @@ def _resolve_slopes(keys: Sequence[Key], times: FloatArray,
     rules_out = np.array([_RULE_CODE[k.out_tangent] for k in keys], dtype=np.int8)
     fixed_in = np.array([k.in_slope for k in keys])
     fixed_out = np.array([k.out_slope for k in keys])
-    s_in = _side(rules_in, fixed_in, left, smooth, clamped)
-    s_out = _side(rules_out, fixed_out, right, smooth, clamped)
+    # Only the rules some key uses are computed and chosen from.
+    used = np.flatnonzero(np.bincount(rules_in, minlength=len(_RULE_CODE))
+                          + np.bincount(rules_out, minlength=len(_RULE_CODE))).tolist()
+    shared: dict[int, FloatArray] = {0: np.zeros(n), 2: smooth, 3: clamped}
+    for code, alpha in ((5, 0.5), (6, 1.0)):
+        if code in used:
+            shared[code] = _catmull_rom_slopes(times, values, alpha, smooth)
+    tcb_in = tcb_out = smooth
+    if 7 in used:
+        tcb_in, tcb_out = _tcb_slopes(keys, times, values, secant)
+    s_in = _side(rules_in, fixed_in, used, {**shared, 1: left, 7: tcb_in})
+    s_out = _side(rules_out, fixed_out, used, {**shared, 1: right, 7: tcb_out})
     return s_in, s_out
 
 
 #: Tangent rules as small integers, for choosing slopes with numpy.
-_RULE_CODE = {Tangent.FLAT: 0, Tangent.LINEAR: 1, Tangent.SMOOTH: 2, Tangent.CLAMPED: 3, Tangent.FIXED: 4}
+_RULE_CODE = {Tangent.FLAT: 0, Tangent.LINEAR: 1, Tangent.SMOOTH: 2, Tangent.CLAMPED: 3, Tangent.FIXED: 4,
+              Tangent.CENTRIPETAL: 5, Tangent.CHORDAL: 6, Tangent.TCB: 7}
 
 
-def _side(rules: npt.NDArray[np.int8], fixed: FloatArray, linear: FloatArray, smooth: FloatArray,
-          clamped: FloatArray) -> FloatArray:
-    """Each key's slope on one side from its rule (flat, linear, smooth, clamped, fixed)."""
-    out: FloatArray = np.select([rules == 0, rules == 1, rules == 2, rules == 3],
-                                [np.zeros_like(fixed), linear, smooth, clamped], fixed)
+def _side(rules: npt.NDArray[np.int8], fixed: FloatArray, used: list[int],
+          slopes: dict[int, FloatArray]) -> FloatArray:
+    """Each key's slope on one side from its rule: ``slopes`` holds every key's slope under
+    each rule code in ``used`` (the fixed rule, 4, takes ``fixed``)."""
+    codes = [code for code in used if code != 4]
+    if not codes:
+        return fixed
+    out: FloatArray = np.select([rules == code for code in codes], [slopes[code] for code in codes], fixed)
     return out
+
+
+def _catmull_rom_slopes(times: FloatArray, values: FloatArray, alpha: float, smooth: FloatArray) -> FloatArray:
+    """The slope ``dv/dt`` at each key of the Catmull-Rom curve through the points
+    ``p = (t, v)`` with knot spacing ``|Δp|^alpha`` (0 uniform, ½ centripetal, 1 chordal).
+
+    The Barry–Goldman pyramid's derivative at an interior knot ``s1`` (neighbours at
+    ``s0``, ``s2``) is ``(p1 − p0)/d0 − (p2 − p0)/(d0 + d1) + (p2 − p1)/d1`` with
+    ``d = |Δp|^alpha``; its time and value components give the slope
+    ``(w0·Δv0 + w1·Δv1) / (w0·Δt0 + w1·Δt1)`` with ``w0 = d1²``, ``w1 = d0²`` (multiplied
+    through by ``d0·d1·(d0 + d1)``; scaled here by the larger one so nothing overflows).
+    The denominator is positive because times increase, so the slope is always finite. At
+    the first and last key the handout's mirrored virtual key makes it the one-sided secant,
+    the same as ``smooth``; ``alpha = 0`` gives ``smooth`` everywhere. Where the arithmetic
+    fails (values near the float limit) the key keeps its smooth slope.
+    """
+    out = smooth.copy()
+    if len(times) < 3:
+        return out
+    dt = np.diff(times)
+    dv = np.diff(values)
+    length = np.hypot(dt, dv)
+    h0, h1 = length[:-1], length[1:]
+    big = np.maximum(h0, h1)
+    with np.errstate(all="ignore"):
+        w0 = (h1 / big) ** (2.0 * alpha)
+        w1 = (h0 / big) ** (2.0 * alpha)
+        slope = (w0 * dv[:-1] + w1 * dv[1:]) / (w0 * dt[:-1] + w1 * dt[1:])
+    out[1:-1] = np.where(np.isfinite(slope), slope, smooth[1:-1])
+    return out
+
+
+def _tcb_slopes(keys: Sequence[Key], times: FloatArray, values: FloatArray,
+                secant: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Kochanek–Bartels in and out slopes of every key (its tension T, continuity C, bias B).
+
+    With ``Δ0 = v[i] − v[i−1]`` and ``Δ1 = v[i+1] − v[i]``, the tangents per unit parameter
+    (Kochanek & Bartels 1984) are
+    ``out = (1−T)/2·((1+B)(1+C)·Δ0 + (1−B)(1−C)·Δ1)`` and
+    ``in = (1−T)/2·((1+B)(1−C)·Δ0 + (1−B)(1+C)·Δ1)``; their step-size adjustment for
+    keys unevenly spaced in time makes both slopes ``tangent · 2 / (t[i+1] − t[i−1])``.
+    So T = C = B = 0 is ``smooth``. At the first and last key, with one neighbour, both
+    slopes are ``(1−T)`` times the one-sided secant (C and B have no second span to weigh).
+    """
+    n = len(keys)
+    tension = np.array([k.tension for k in keys])
+    cont = np.array([k.continuity for k in keys])
+    bias = np.array([k.bias for k in keys])
+    scale = 1.0 - tension
+    s_in = np.empty(n)
+    s_out = np.empty(n)
+    s_in[0] = s_out[0] = scale[0] * secant[0]
+    s_in[-1] = s_out[-1] = scale[-1] * secant[-1]
+    if n > 2:
+        d0 = values[1:-1] - values[:-2]
+        d1 = values[2:] - values[1:-1]
+        t, c, b = scale[1:-1], cont[1:-1], bias[1:-1]
+        per_second = 2.0 / (times[2:] - times[:-2])
+        s_out[1:-1] = 0.5 * t * ((1 + b) * (1 + c) * d0 + (1 - b) * (1 - c) * d1) * per_second
+        s_in[1:-1] = 0.5 * t * ((1 + b) * (1 - c) * d0 + (1 - b) * (1 + c) * d1) * per_second
+    return s_in, s_out
 
 
 def catmull_rom(points: Iterable[tuple[float, float]]) -> Channel:

@@ -10,6 +10,9 @@ Two solvers:
   to the dragged joint, Levenberg-Marquardt style adaptive damping (every accepted step lowers
   the error), joint limits by clamping and freezing, the root frozen by default.
 
+CCD, FABRIK and the analytic two-bone solver are in :mod:`qtanimator.core.ik_methods`; every
+2D solver takes joint limits in either form :func:`limit_bounds` reads.
+
 Dynamic (pendulum) joints keep their **world** angle while their ancestors turn (that is
 what the simulation does), so a dynamic joint on the chain passes its ancestors' motion on
 as a translation only; the Jacobian takes that into account, and dynamic joints are never
@@ -21,6 +24,9 @@ from __future__ import annotations
 
 import math
 import weakref
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TypeAlias
 
 import numpy as np
 import numpy.typing as npt
@@ -30,6 +36,37 @@ from qtanimator.core.rig2d import Character, Pose
 FloatArray = npt.NDArray[np.float64]
 
 HANDOUT_STEP = 1e-6
+
+#: Joint limits as the 2D solvers take them: a (J, 2) array of [min, max] local angles
+#: (±inf for none), or one ``(lo, hi)`` or None (free) per joint.
+Limits: TypeAlias = "npt.ArrayLike | Sequence[tuple[float, float] | None] | None"
+
+
+@dataclass
+class IKStats:
+    """What a solve did, filled in when a solver is given one (benchmarks, tests)."""
+
+    iterations: int = 0
+    error: float = math.nan
+    method: str = ""
+
+
+def limit_bounds(limits: Limits, count: int) -> tuple[FloatArray, FloatArray] | None:
+    """``(lo, hi)`` arrays (``count``,) of local-angle limits, ±inf where a joint is free;
+    None when no joint is limited. Accepts a (J, 2) array or a list of ``(lo, hi) | None``
+    (``character2d.joint_limits``)."""
+    if limits is None:
+        return None
+    if isinstance(limits, (list, tuple)) and any(v is None for v in limits):
+        arr = np.array([(-math.inf, math.inf) if v is None else v for v in limits], dtype=np.float64)
+    else:
+        arr = np.asarray(limits, dtype=np.float64)
+    arr = arr.reshape(count, 2)
+    lo = np.where(np.isnan(arr[:, 0]), -math.inf, arr[:, 0])
+    hi = np.where(np.isnan(arr[:, 1]), math.inf, arr[:, 1])
+    if not (np.isfinite(lo).any() or np.isfinite(hi).any()):
+        return None
+    return lo, hi
 
 
 def _pose(character: Character, pose_or_angles: Pose | npt.ArrayLike,
@@ -59,11 +96,23 @@ def handout_gradient(character: Character, pose_or_angles: Pose | npt.ArrayLike,
 
 def gradient_descent_step(character: Character, angles: npt.ArrayLike, translation: npt.ArrayLike,
                           joint: int, local_point: npt.ArrayLike, target: npt.ArrayLike,
-                          step: float = HANDOUT_STEP, iterations: int = 10) -> FloatArray:
-    """The handout's per-frame IK update: ``iterations`` steps of angle += step·D."""
+                          step: float = HANDOUT_STEP, iterations: int = 10, limits: Limits = None,
+                          stats: IKStats | None = None) -> FloatArray:
+    """The handout's per-frame IK update: ``iterations`` steps of angle += step·D; with
+    ``limits`` each step is projected onto them (projected gradient descent), for the joints
+    the step moves."""
     a = np.array(angles, dtype=np.float64)
+    bounds = limit_bounds(limits, len(a))
     for _ in range(iterations):
-        a += step * handout_gradient(character, a, joint, local_point, target, translation)
+        d = handout_gradient(character, a, joint, local_point, target, translation)
+        a += step * d
+        if bounds is not None:
+            moved = d != 0
+            a[moved] = np.clip(a[moved], bounds[0][moved], bounds[1][moved])
+    if stats is not None:
+        stats.iterations = iterations
+        stats.error = ik_error(character, a, translation, joint, local_point, target)
+        stats.method = "handout"
     return a
 
 
@@ -183,13 +232,14 @@ class _Chain:
 
 def solve_ik(character: Character, angles: npt.ArrayLike, translation: npt.ArrayLike, joint_index: int,
              local_point: npt.ArrayLike, target: npt.ArrayLike,
-             limits: npt.ArrayLike | None = None, *, freeze_root: bool = True, tolerance: float = 1e-4,
-             max_iterations: int = 100, damping: float = 1e-3, hold_dynamic: bool = True) -> FloatArray:
+             limits: Limits = None, *, freeze_root: bool = True, tolerance: float = 1e-4,
+             max_iterations: int = 100, damping: float = 1e-3, hold_dynamic: bool = True,
+             stats: IKStats | None = None) -> FloatArray:
     """New local angles (J,) that bring ``local_point`` of ``joint_index`` towards ``target``.
 
     Damped least squares with adaptive (Levenberg-Marquardt) damping: a step is kept only
     if it lowers the distance, otherwise the damping grows, so the result is never worse
-    than the start. ``limits`` is (J, 2) of [min, max] local angles (±inf for none); a
+    than the start. ``limits`` (:data:`Limits`) are [min, max] local angles; a
     joint that hits a limit is clamped and frozen for the rest of that iteration. Only the
     chain from the root to ``joint_index`` moves; the root turns only with
     ``freeze_root=False``. An unreachable target gives the closest stretch, never NaN.
@@ -197,14 +247,16 @@ def solve_ik(character: Character, angles: npt.ArrayLike, translation: npt.Array
     """
     a0 = np.array(angles, dtype=np.float64).reshape(len(character.joints))
     q = np.asarray(target, dtype=np.float64).reshape(2)
+    if stats is not None:
+        stats.method, stats.iterations = "dls", 0
     if not np.all(np.isfinite(q)):
         return a0
     chain = _Chain(character, a0, translation, joint_index, local_point, freeze_root)
     n = chain.n
     local0 = a0[chain.idx]
-    if limits is not None:
-        lim = np.asarray(limits, dtype=np.float64).reshape(len(character.joints), 2)[chain.idx]
-        lo, hi = lim[:, 0], lim[:, 1]
+    bounds = limit_bounds(limits, len(a0))
+    if bounds is not None:
+        lo, hi = bounds[0][chain.idx], bounds[1][chain.idx]
     delta = np.zeros(n)
     _, pivots, tip = chain.evaluate(delta)
     err = q - tip
@@ -213,9 +265,13 @@ def solve_ik(character: Character, angles: npt.ArrayLike, translation: npt.Array
     lam2 = damping * scale * scale
     tol2 = tolerance * tolerance
     if not chain.var.any():
+        if stats is not None:
+            stats.error = math.sqrt(err2)
         return a0
-    for _ in range(max_iterations):
+    iterations = 0
+    for iterations in range(1, max_iterations + 1):
         if err2 <= tol2:
+            iterations -= 1
             break
         jac = chain.jacobian(pivots, tip)
         free = chain.var
@@ -223,7 +279,7 @@ def solve_ik(character: Character, angles: npt.ArrayLike, translation: npt.Array
         for _attempt in range(12):
             step = _dls_step(jac, err, lam2)
             cand = delta + step
-            if limits is not None:
+            if bounds is not None:
                 clipped = np.clip(local0 + cand, lo, hi) - local0
                 hit = (clipped != cand) & free
                 if hit.any():
@@ -241,8 +297,17 @@ def solve_ik(character: Character, angles: npt.ArrayLike, translation: npt.Array
             lam2 *= 4.0
         if not improved:
             break
-    out = a0.copy()
-    out[chain.idx] = local0 + delta
+    if stats is not None:
+        stats.iterations, stats.error = iterations, math.sqrt(err2)
+    return chain_result(chain, a0, delta, hold_dynamic)
+
+
+def chain_result(chain: _Chain, angles: FloatArray, delta: FloatArray, hold_dynamic: bool = True) -> FloatArray:
+    """Every joint's local angle (J,) after the chain's local changes ``delta``: the chain
+    joints changed, and (``hold_dynamic``) each dynamic joint hanging from a chain joint
+    turned back by its parent's world-angle change, so that it keeps its world angle."""
+    out = np.array(angles, dtype=np.float64)
+    out[chain.idx] = out[chain.idx] + delta
     plan = chain.plan
     if hold_dynamic and len(plan.follow_joint):
         # a dynamic joint keeps its world angle: undo its parent's world-angle change

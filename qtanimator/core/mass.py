@@ -61,6 +61,7 @@ class ShapeLike(Protocol):
     stroke_width: float
     opacity: float
     ellipse: tuple[FloatArray, FloatArray] | None
+    density_opacity: float | None
 
 
 def stroke_density(alpha: float, width: float) -> float:
@@ -68,9 +69,11 @@ def stroke_density(alpha: float, width: float) -> float:
 
 
 def shape_densities(shape: ShapeLike) -> tuple[float, float]:
-    """(fill density, stroke density) by the starter's rules."""
+    """(fill density, stroke density) by the starter's rules: the element's own opacity
+    scales the fill density, its groups' opacity does not (``notes/cmu-animator.md`` 1.2)."""
     rho_s = stroke_density(shape.stroke[3], shape.stroke_width)
-    a_fill = shape.fill[3] * shape.opacity
+    own = shape.opacity if shape.density_opacity is None else shape.density_opacity
+    a_fill = shape.fill[3] * own
     rho_f = a_fill if a_fill != 0 else rho_s
     return rho_f, rho_s
 

@@ -17,18 +17,24 @@ symplectic Euler (ω ← ω + τ·θ''; θ ← θ + τ·ω) at a fixed step, the
 coupled chain's Hamiltonian is not separable (its mass matrix depends on the angles), where
 explicit symplectic Euler gains energy, so coupled chains always use RK4 (energy error
 O(τ⁴), below 1e-5 relative over thousands of steps in the tests).
+
+Joint limits (``limits``: the local angle relative to the parent, by joint) make a dynamic
+joint bounce: the step is cut at the crossing, the relative angular velocity is reversed and
+scaled by ``restitution`` (:mod:`qtanimator.core.joint_bounce`), so each bounce keeps e² of
+the kinetic energy at impact.
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
+from qtanimator.core.joint_bounce import ON_LIMIT, Bounce, BoundedUnit, bounded_step, hermite
 from qtanimator.core.rig2d import Character
 
 FloatArray = npt.NDArray[np.float64]
@@ -44,6 +50,8 @@ class PendulumParams:
     """Simulation constants of one character.
 
     ``g`` (units/s²) pulls towards +y. ``damping`` is a in ω ← ω·e^(−aτ) (1/s).
+    ``restitution`` e (0 … 1) is the share of its speed a joint keeps when it bounces off
+    one of its angle limits (0: it stops dead; 1: a perfect bounce).
     ``length_scale`` scales y0 and the chain offsets before anything uses them (the handout's
     1/1000). ``accel_scale`` / ``rotation_accel_scale`` scale the pivot acceleration from the
     root's translation and from keyframed ancestors' rotation. ``inertia`` is ``exact`` or
@@ -53,6 +61,7 @@ class PendulumParams:
 
     g: float = 3000.0
     damping: float = 0.3
+    restitution: float = 0.5
     length_scale: float = 1.0
     accel_scale: float = 1.0
     rotation_accel_scale: float = 1.0
@@ -72,6 +81,8 @@ class PendulumParams:
         for name in ("g", "damping", "length_scale", "accel_scale", "rotation_accel_scale"):
             if not math.isfinite(float(getattr(self, name))):
                 raise ValueError(f"{name} must be finite")
+        if not 0.0 <= float(self.restitution) <= 1.0:
+            raise ValueError("restitution must be between 0 (a joint stops at its limit) and 1 (a perfect bounce)")
 
     def to_dict(self) -> dict[str, Any]:
         return asdict(self)
@@ -175,9 +186,14 @@ class PendulumGroup:
 
 
 class PendulumSystem:
-    """All dynamic joints of one character and their integration."""
+    """All dynamic joints of one character and their integration.
 
-    def __init__(self, character: Character, params: PendulumParams | None = None) -> None:
+    ``limits`` (by joint index, None = free) bound the dynamic joints' local angles
+    (relative to the parent, radians); a joint that reaches one bounces (see the module).
+    """
+
+    def __init__(self, character: Character, params: PendulumParams | None = None,
+                 limits: Sequence[tuple[float, float] | None] | None = None) -> None:
         self.character = character
         self.params = params or PendulumParams()
         self.groups = _build_groups(character, self.params)
@@ -187,6 +203,33 @@ class PendulumSystem:
         self._singles = (np.array([g.top for g in singles], dtype=np.intp),
                          np.array([g.mass[0] for g in singles]), np.array([g.inertia[0] for g in singles]),
                          offset, (offset ** 2).sum(axis=1))
+        n = len(character.joints)
+        self.limits = np.tile(np.array([-math.inf, math.inf]), (n, 1))
+        for k, lim in enumerate(limits or []):
+            if lim is not None and k < n and character.joints[k].is_dynamic:
+                self.limits[k] = (float(lim[0]), float(lim[1]))
+        #: Dynamic joints with a limit: they bounce.
+        self.bounded = np.asarray(character.dynamic & np.isfinite(self.limits).any(axis=1), dtype=bool)
+        #: The bounces of the last :meth:`step`.
+        self.bounces: list[Bounce] = []
+        # The dynamic part of each joint's parent's world angle: its nearest dynamic
+        # ancestor-or-self (−1: none; the parent's world angle is then all keyed).
+        nearest = [-1] * n
+        self._parent_dynamic = np.full(n, -1, dtype=np.intp)
+        for k, j in enumerate(character.joints):
+            if j.parent is not None:
+                self._parent_dynamic[k] = nearest[j.parent]
+            nearest[k] = k if j.is_dynamic else (-1 if j.parent is None else nearest[j.parent])
+        self._units: list[tuple[int, PendulumGroup | int]] = []  # (top, group or single's position)
+        for pos, top in enumerate(self._singles[0]):
+            if self.bounded[int(top)]:
+                self._units.append((int(top), pos))
+        for g in self._coupled:
+            if self.bounded[g.joints].any():
+                self._units.append((g.top, g))
+        self._units.sort(key=lambda u: u[0])
+        self._bounded_singles = np.array([int(self._singles[0][u]) for _t, u in self._units
+                                          if not isinstance(u, PendulumGroup)], dtype=np.intp)
 
     @property
     def dynamic_joints(self) -> list[int]:
@@ -234,14 +277,19 @@ class PendulumSystem:
             return self.group_acceleration(g, t, w, a)
         return f
 
-    def _singles_fn(self, acc: FloatArray) -> Callable[[FloatArray, FloatArray], FloatArray]:
+    def _singles_fn(self, acc: FloatArray,
+                    sel: npt.NDArray[np.intp] | None = None) -> Callable[[FloatArray, FloatArray], FloatArray]:
         def f(t: FloatArray, w: FloatArray) -> FloatArray:
-            return self._singles_acceleration(t, w, acc)
+            return self._singles_acceleration(t, w, acc, sel)
         return f
 
-    def _singles_acceleration(self, th: FloatArray, om: FloatArray, acc: FloatArray) -> FloatArray:
-        """θ'' of all single (uncoupled) joints at once; ``acc`` is (k, 2)."""
+    def _singles_acceleration(self, th: FloatArray, om: FloatArray, acc: FloatArray,
+                              sel: npt.NDArray[np.intp] | None = None) -> FloatArray:
+        """θ'' of all single (uncoupled) joints at once; ``acc`` is (k, 2). ``sel``: only
+        the singles at these positions (``th``, ``om`` and ``acc`` are theirs)."""
         idx, mass, inertia, offset, ell2 = self._singles
+        if sel is not None:
+            mass, inertia, offset, ell2 = mass[sel], inertia[sel], offset[sel], ell2[sel]
         p = self.params
         c, s = np.cos(th), np.sin(th)
         yx = c * offset[:, 0] + s * offset[:, 1]
@@ -257,31 +305,49 @@ class PendulumSystem:
         return np.asarray(out, dtype=np.float64)
 
     def _advance_singles(self, th: FloatArray, om: FloatArray, acc: FloatArray,
-                         tau: float) -> tuple[FloatArray, FloatArray]:
+                         tau: float, sel: npt.NDArray[np.intp] | None = None) -> tuple[FloatArray, FloatArray]:
         """One undamped step of the single pendulums with the chosen integrator."""
-        f = self._singles_acceleration
+        f = self._singles_fn(acc, sel)
         method = self.params.integrator
         if method == "symplectic_euler":
-            om = om + tau * f(th, om, acc)
+            om = om + tau * f(th, om)
             th = th + tau * om
         elif method == "leapfrog":
-            om = om + 0.5 * tau * f(th, om, acc)
+            om = om + 0.5 * tau * f(th, om)
             th = th + tau * om
-            om = om + 0.5 * tau * f(th, om, acc)
+            om = om + 0.5 * tau * f(th, om)
         else:
-            th, om = _rk4(self._singles_fn(acc), th, om, tau)
+            th, om = _rk4(f, th, om, tau)
         return th, om
 
+    def group_mass_matrix(self, g: PendulumGroup, theta: FloatArray) -> FloatArray:
+        """The mass matrix M(θ) of a coupled group (world angles as coordinates)."""
+        n = len(g.joints)
+        if not self.params.coupled or n == 1:
+            return np.diag(np.asarray(g.inertia, dtype=np.float64))
+        w = rotate(g.arm, theta[:, None]) * g.ancestor[:, :, None]
+        flat = w.reshape(n, 2 * n)
+        m = g.mass
+        return np.asarray((flat * np.repeat(m, 2)) @ flat.T + np.diag(g.inertia - m * (g.offset ** 2).sum(axis=1)),
+                          dtype=np.float64)
+
     def step(self, theta: FloatArray, omega: FloatArray, pivot_acc: Callable[[int], FloatArray] | FloatArray,
-             tau: float | None = None) -> None:
+             tau: float | None = None, parent_motion: FloatArray | None = None) -> None:
         """Advance the world angles ``theta`` and rates ``omega`` (J,) in place by one step.
 
         ``pivot_acc`` gives the acceleration (units/s², already scaled) of each group's top
         pivot: an array (J, 2) indexed by joint, or a function of the top joint's index.
         Single joints use the chosen integrator; coupled chains are not separable
         Hamiltonian systems (symplectic Euler gains energy there), so they use RK4.
+
+        ``parent_motion`` (J, 4) matters only with limits: for each joint, the keyed part of
+        its parent's world angle (the local angles after the nearest dynamic ancestor) as
+        angle and rate at the step's start, then at its end; None: 0 (a still parent).
         """
         tau = self.params.step if tau is None else tau
+        if self._units:
+            self._step_bounded(theta, omega, pivot_acc, tau, parent_motion)
+            return
         decay = _decay(self.params.damping, tau)
         idx = self._singles[0]
         if len(idx):
@@ -300,11 +366,128 @@ class PendulumSystem:
             theta[gi] = th
             omega[gi] = om * decay
 
+    def _step_bounded(self, theta: FloatArray, omega: FloatArray,
+                      pivot_acc: Callable[[int], FloatArray] | FloatArray, tau: float,
+                      parent_motion: FloatArray | None) -> None:
+        """:meth:`step` with limits: every unit steps freely, then each unit whose joints
+        left their limits (parents first) steps again with exact bounces."""
+        decay = _decay(self.params.damping, tau)
+        start_t, start_w = theta.copy(), omega.copy()
+        self.bounces = []
+        idx = self._singles[0]
+        acc = np.zeros((0, 2))
+        if len(idx):
+            if callable(pivot_acc):
+                acc = np.array([pivot_acc(int(j)) for j in idx], dtype=np.float64).reshape(-1, 2)
+            else:
+                acc = np.asarray(pivot_acc, dtype=np.float64)[idx]
+            theta[idx], omega[idx] = self._advance_singles(theta[idx], omega[idx], acc, tau)
+        group_acc: dict[int, FloatArray] = {}
+        for g in self._coupled:
+            gi = np.asarray(g.joints)
+            a = pivot_acc(g.top) if callable(pivot_acc) else np.asarray(pivot_acc)[g.top]
+            group_acc[g.top] = a = np.asarray(a, dtype=np.float64)
+            theta[gi], omega[gi] = _rk4(self._group_fn(g, a), theta[gi], omega[gi], tau)
+        keyed = np.zeros((len(theta), 4)) if parent_motion is None else np.asarray(parent_motion, dtype=np.float64)
+        # Which single pendulums left their limits, all at once; a unit is looked at again
+        # below only when flagged or when the dynamic ancestor its parent hangs from bounced.
+        flagged = np.zeros(len(theta), dtype=bool)
+        if len(self._bounded_singles):
+            m = self._bounded_singles
+            dyn = self._parent_dynamic[m]
+            has, d = dyn >= 0, np.maximum(dyn, 0)
+            loc0 = start_t[m] - keyed[m, 0] - np.where(has, start_t[d], 0.0)
+            loc1 = theta[m] - keyed[m, 2] - np.where(has, theta[d], 0.0)
+            lo, hi = self.limits[m, 0], self.limits[m, 1]
+            out = (loc0 < lo) | (loc0 > hi) | (loc1 < lo) | (loc1 > hi)
+            # Resting contact, at once: on its limit at the start and pushed past it by the
+            # free step, not moving faster than one step's change of speed (a bounce slower
+            # than that is contact the step cannot resolve): stopped on the limit, moving
+            # with its parent. Only where the parent's dynamic ancestor cannot bounce itself.
+            bound = np.where(loc1 > hi, hi, lo)
+            v0 = start_w[m] - keyed[m, 1] - np.where(has, start_w[d], 0.0)
+            r1 = keyed[m, 3] + np.where(has, omega[d], 0.0)
+            v1 = omega[m] - r1
+            resting = (out & (np.abs(loc0 - bound) <= ON_LIMIT) & ((loc1 > hi) | (loc1 < lo))
+                       & (np.abs(v0) <= np.abs(v1 - v0)) & ~(has & self.bounded[d]))
+            if resting.any():
+                r = m[resting]
+                theta[r] = (theta[m] - loc1 + bound)[resting]
+                omega[r] = r1[resting]
+                out &= ~resting
+            flagged[m] = out
+        moved = np.zeros(len(theta), dtype=bool)
+        for _top, unit_of in self._units:
+            if not isinstance(unit_of, PendulumGroup):
+                j = int(idx[unit_of])
+                if not flagged[j] and not (self._parent_dynamic[j] >= 0 and moved[self._parent_dynamic[j]]):
+                    continue
+            if isinstance(unit_of, PendulumGroup):
+                g = unit_of
+                members = np.asarray(g.joints, dtype=np.intp)
+                parent = np.asarray(g.parent, dtype=np.intp)
+                step_fn = self._group_step(g, group_acc[g.top])
+                mass_fn: Callable[[FloatArray], FloatArray] | None = self._group_mass(g)
+            else:
+                pos = unit_of
+                members = np.array([idx[pos]], dtype=np.intp)
+                parent = np.array([-1], dtype=np.intp)
+                step_fn = self._single_step(acc[pos:pos + 1], np.array([pos], dtype=np.intp))
+                mass_fn = None
+            # The outside parents' world angles over the step: keyed part + dynamic part,
+            # each exact at both ends (ancestors' units are final: they come first).
+            dyn = self._parent_dynamic[members]
+            has, d = dyn >= 0, np.maximum(dyn, 0)
+            km = keyed[members]
+            p0, p1 = km[:, 0] + np.where(has, start_t[d], 0.0), km[:, 2] + np.where(has, theta[d], 0.0)
+            inside = parent >= 0
+            pi = np.maximum(parent, 0)
+            lo, hi = self.limits[members, 0], self.limits[members, 1]
+            loc0 = start_t[members] - np.where(inside, start_t[members][pi], p0)
+            loc1 = theta[members] - np.where(inside, theta[members][pi], p1)
+            if ((loc0 >= lo) & (loc0 <= hi) & (loc1 >= lo) & (loc1 <= hi)).all():
+                continue
+            outside = hermite(p0, km[:, 1] + np.where(has, start_w[d], 0.0),
+                              p1, km[:, 3] + np.where(has, omega[d], 0.0), tau)
+            unit = BoundedUnit(members, lo, hi, parent, outside, mass_fn)
+            theta[members], omega[members] = bounded_step(unit, step_fn, start_t[members], start_w[members], tau,
+                                                          self.params.restitution, self.bounces)
+            moved[members] = True
+        dyn_all = np.asarray(self.dynamic_joints, dtype=np.intp)
+        omega[dyn_all] = omega[dyn_all] * decay
+
+    def _single_step(self, acc: FloatArray, sel: npt.NDArray[np.intp]
+                     ) -> Callable[[FloatArray, FloatArray, float, float], tuple[FloatArray, FloatArray]]:
+        def f(th: FloatArray, om: FloatArray, _t: float, h: float) -> tuple[FloatArray, FloatArray]:
+            return self._advance_singles(th, om, acc, h, sel)
+        return f
+
+    def _group_step(self, g: PendulumGroup, a: FloatArray
+                    ) -> Callable[[FloatArray, FloatArray, float, float], tuple[FloatArray, FloatArray]]:
+        fn = self._group_fn(g, a)
+
+        def f(th: FloatArray, om: FloatArray, _t: float, h: float) -> tuple[FloatArray, FloatArray]:
+            return _rk4(fn, th, om, h)
+        return f
+
+    def _group_mass(self, g: PendulumGroup) -> Callable[[FloatArray], FloatArray]:
+        def f(th: FloatArray) -> FloatArray:
+            return self.group_mass_matrix(g, th)
+        return f
+
     def run(self, theta: FloatArray, omega: FloatArray, pivot_acc: FloatArray, steps: int,
             tau: float | None = None) -> tuple[FloatArray, FloatArray]:
         """``steps`` steps with a constant pivot acceleration (J, 2), in place; returns the
         trajectory of world angles and rates, each (steps, J)."""
         tau = self.params.step if tau is None else tau
+        if self._units:
+            acc_b = np.asarray(pivot_acc, dtype=np.float64).reshape(len(theta), 2)
+            out_t = np.empty((steps, len(theta)))
+            out_w = np.empty((steps, len(theta)))
+            for i in range(steps):
+                self.step(theta, omega, acc_b, tau)
+                out_t[i], out_w[i] = theta, omega
+            return out_t, out_w
         acc_all = np.asarray(pivot_acc, dtype=np.float64).reshape(len(theta), 2)
         idx = self._singles[0]
         acc = acc_all[idx]

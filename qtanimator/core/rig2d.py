@@ -35,6 +35,8 @@ class Shape:
     geometry in ``ellipse`` = (centre, A) with the ellipse = centre + A·(unit disc).
     Colours are RGBA in 0…1; ``fill`` alpha includes ``fill-opacity``, and ``opacity`` is
     the element's group opacity (applied to fill and stroke when drawing).
+    ``density_opacity`` is the element's own ``opacity`` only, the factor the starter's
+    fill density uses (groups' opacity is a look, not a mass); None: ``opacity``.
     """
 
     points: FloatArray
@@ -45,6 +47,7 @@ class Shape:
     opacity: float = 1.0
     kind: str = "polygon"
     ellipse: tuple[FloatArray, FloatArray] | None = None
+    density_opacity: float | None = None
 
     def bounds(self) -> tuple[float, float, float, float]:
         """(xmin, ymin, xmax, ymax) of the outline, stroke included."""
@@ -111,6 +114,9 @@ class Joint:
     #: rest frame, the frame of ``shapes``; drawn by a real SVG renderer. None: draw
     #: ``shapes`` (characters built from geometry alone).
     svg: str | None = None
+    #: A spring joint: its keyed local angle is followed through a damped spring
+    #: (:mod:`qtanimator.core.spring_joint`). A dynamic joint is never a spring.
+    is_spring: bool = False
 
     @property
     def mass(self) -> float:
@@ -194,6 +200,9 @@ class Character:
         self.parents = np.array([-1 if j.parent is None else j.parent for j in joints], dtype=np.intp)
         self.rest_pivots = np.array([j.pivot for j in joints], dtype=np.float64).reshape(-1, 2)
         self.dynamic = np.array([j.is_dynamic for j in joints], dtype=bool)
+        self.spring = np.array([j.is_spring and not j.is_dynamic for j in joints], dtype=bool)
+        #: Joints the simulation moves: dynamic (pendulum) and spring joints.
+        self.simulated = self.dynamic | self.spring
         n = len(joints)
         ancestry = np.zeros((n, n))
         for k, j in enumerate(joints):

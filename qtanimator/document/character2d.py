@@ -21,6 +21,20 @@ character and every position keyed at that time).
 Pendulum parameters are document parameters ``"<asset>.pendulum.<name>"`` (see
 :class:`qtanimator.core.pendulum.PendulumParams`); :func:`set_pendulum_preset` applies a
 named preset (``physical`` or ``handout``).
+
+A spring joint's channel holds its keyed local angle, as a keyframed joint's does; the
+simulation makes the joint follow it through a damped spring (secondary motion,
+:mod:`qtanimator.core.spring_joint`). Its constants are document parameters
+``"<asset>.spring.<name>"`` (:class:`~qtanimator.core.spring_joint.SpringParams`);
+:func:`set_spring_preset` applies ``soft`` or ``stiff``. Springs run in the pendulum cache,
+on its worker thread, with the pendulums' sub-step.
+
+Joint limits are document parameters ``"<asset>.limits.<joint name>"`` holding ``[lo, hi]``,
+the range of the joint's **local** angle (relative to its parent, radians). A keyframed
+joint's angle is clamped to its range wherever it is evaluated (the channel keeps its keys,
+as Maya's transform limits do) and every edit that keys or poses a joint clamps the value it
+writes (:func:`clamp_values`); :func:`joint_limits` gives them by joint index to the IK
+solvers and the pendulums.
 """
 
 from __future__ import annotations
@@ -38,34 +52,29 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Key
-from qtanimator.core.ik import gradient_descent_step, solve_ik
 from qtanimator.core.pendulum import PRESETS, PendulumBlowUp, PendulumParams, PendulumSystem, check_state
 from qtanimator.core.rig2d import Character, Pose
+from qtanimator.core.spring_joint import SPRING_PRESETS, SpringParams, SpringSystem
 from qtanimator.document.commands import AddAsset, Command, DeleteKeys, Macro, SetKeys, SetParameter
-from qtanimator.document.document import Asset, Document, DocumentChange, channel_id, split_channel_id
+from qtanimator.document.document import (
+    PROJECT_DEFAULTS,
+    Asset,
+    Document,
+    DocumentChange,
+    channel_id,
+    split_channel_id,
+)
+from qtanimator.document.ik_settings import IK_DEFAULTS as IK_DEFAULTS
+from qtanimator.document.ik_settings import ik_setting as ik_setting
+from qtanimator.document.ik_settings import solve_character
 from qtanimator.document.pose import pending_value, pending_values
 from qtanimator.document.simulation import SimulationWorker, ui_idle
 
 ASSET_KIND = "character2d"
 KEY_ALL_PARAMETER = "animation.key_all"
 
-#: IK solver settings: document parameters with their defaults (edited in the properties
-#: dock). ``ik.solver`` is "dls" (damped least squares, limits respected) or "handout" (the
-#: course handout's gradient descent); ``ik.gradient_arrow_scale`` only scales the debug arrows.
-IK_DEFAULTS: dict[str, Any] = {
-    "ik.solver": "dls",
-    "ik.freeze_root": True,
-    "ik.max_iterations": 100,
-    "ik.damping": 1e-3,
-    "ik.handout_step": 1e-6,
-    "ik.handout_iterations": 10,
-    "ik.gradient_arrow_scale": 0.1,
-}
-
-
-def ik_setting(doc: Document, name: str) -> Any:
-    """One IK setting of the document (its default when unset)."""
-    return doc.parameter(name, IK_DEFAULTS[name])
+# IK settings (``IK_DEFAULTS``, ``ik_setting``) and the solver they pick live in
+# qtanimator.document.ik_settings (shared with 3D); imported here for existing callers.
 DELETE_TOLERANCE_FRAMES = 0.1
 FloatArray = npt.NDArray[np.float64]
 
@@ -89,12 +98,24 @@ def load_character_asset(asset: Asset) -> Character:
     return chars[index]
 
 
-def add_characters_command(doc: Document, path: str | Path) -> Command:
-    """A command adding every character of an SVG file or folder (FormatError if unreadable)."""
+#: The frame range of a new, empty document (``PROJECT_DEFAULTS``).
+NEW_PROJECT_RANGE = (int(PROJECT_DEFAULTS["frame_start"]), int(PROJECT_DEFAULTS["frame_end"]))
+#: The last frame of a new project of SVG characters: the CMU animator's timeline starts at 300.
+SVG_PROJECT_FRAME_END = 300
+
+
+def add_characters_command(doc: Document, path: str | Path, new_project_range: bool = False) -> Command:
+    """A command adding every character of an SVG file or folder (FormatError if unreadable).
+
+    With ``new_project_range`` (opening in the GUI, ``qtanimator render``), characters added
+    to a new, empty document (no assets, no channels, the default range) also set the range
+    to the CMU animator's 0…300, in the same undo step."""
     from qtanimator.formats.svg_rig import load_characters
 
     source = str(Path(path).resolve())
     chars = load_characters(source)
+    new_project = (new_project_range and not doc.assets and not doc.channels
+                   and doc.frame_range == NEW_PROJECT_RANGE)
     taken = set(doc.assets)
     commands: list[Command] = []
     for i, ch in enumerate(chars):
@@ -107,9 +128,13 @@ def add_characters_command(doc: Document, path: str | Path) -> Command:
         taken.add(asset_id)
         asset = Asset(asset_id, ASSET_KIND, source, {"index": i})
         commands.append(AddAsset(asset, ch))
+    text = commands[0].text if len(commands) == 1 else f"Add {len(commands)} characters"
+    if new_project and commands:
+        # A new project of SVG characters gets the CMU animator's range, 0…300, in the same step.
+        commands.append(SetParameter(doc, "frame_end", SVG_PROJECT_FRAME_END))
     if len(commands) == 1:
         return commands[0]
-    return Macro(f"Add {len(commands)} characters", commands)
+    return Macro(text, commands)
 
 
 def character(doc: Document, asset_id: str) -> Character:
@@ -137,6 +162,126 @@ def position_channel_ids(asset_id: str) -> tuple[str, str]:
     return channel_id(asset_id, "", "x"), channel_id(asset_id, "", "y")
 
 
+# ------------------------------------------------------------------ joint limits
+def limits_parameter(asset_id: str, joint_name: str) -> str:
+    """The document parameter holding a joint's limits ``[lo, hi]`` (local angle, radians)."""
+    return f"{asset_id}.limits.{joint_name}"
+
+
+def _limit_pair(value: Any) -> tuple[float, float] | None:
+    """A stored ``[lo, hi]`` as floats; None for anything else (a hand-edited project's
+    malformed entry leaves the joint free rather than breaking every evaluation)."""
+    if not isinstance(value, (list, tuple)) or len(value) != 2 or any(isinstance(v, bool) for v in value):
+        return None
+    try:
+        lo, hi = float(value[0]), float(value[1])
+    except (TypeError, ValueError):
+        return None
+    if not (math.isfinite(lo) and math.isfinite(hi)) or lo > hi:
+        return None
+    return lo, hi
+
+
+def joint_limits(doc: Document, asset_id: str) -> list[tuple[float, float] | None]:
+    """Each joint's limits ``(lo, hi)`` on its local angle (radians, relative to its
+    parent), by joint index; None for a free joint."""
+    ch = character(doc, asset_id)
+    params = doc.parameters
+    return [_limit_pair(params.get(limits_parameter(asset_id, j.name))) for j in ch.joints]
+
+
+def limits_array(doc: Document, asset_id: str) -> FloatArray:
+    """:func:`joint_limits` as a (J, 2) array, ±inf for free joints (``solve_ik``'s form)."""
+    out = np.tile(np.array([-math.inf, math.inf]), (len(character(doc, asset_id).joints), 1))
+    for k, lim in enumerate(joint_limits(doc, asset_id)):
+        if lim is not None:
+            out[k] = lim
+    return out
+
+
+def set_joint_limits_command(doc: Document, asset_id: str, joint: int | str, lo: float | None,
+                             hi: float | None = None, gesture: Hashable | None = None) -> Command:
+    """Limit ``joint`` (index or name) to local angles ``lo``…``hi`` (radians), or free it
+    with ``lo`` and ``hi`` None: one undo step, saved with the project as a parameter.
+    ValueError for an unknown joint, a missing, non-finite or reversed bound."""
+    ch = character(doc, asset_id)
+    if isinstance(joint, str):
+        index = ch.joint_index(joint) if joint in {j.name for j in ch.joints} else -1
+    else:
+        index = int(joint)
+    if not 0 <= index < len(ch.joints):
+        raise ValueError(f"'{asset_id}' has no joint {joint!r}")
+    name = ch.joints[index].name
+    path = limits_parameter(asset_id, name)
+    if lo is None and hi is None:
+        return SetParameter(doc, path, None, text=f"Free {name}", gesture=gesture)
+    if lo is None or hi is None:
+        raise ValueError("a joint limit needs both a minimum and a maximum")
+    lo_f, hi_f = float(lo), float(hi)
+    if not (math.isfinite(lo_f) and math.isfinite(hi_f)):
+        raise ValueError("joint limits must be finite numbers")
+    if lo_f > hi_f:
+        raise ValueError(f"the minimum ({math.degrees(lo_f):.6g}°) is above the maximum ({math.degrees(hi_f):.6g}°)")
+    return SetParameter(doc, path, [lo_f, hi_f], text=f"Limit {name}", gesture=gesture)
+
+
+def clamp_angle(doc: Document, asset_id: str, joint_index: int, angle: float) -> float:
+    """A local ``angle`` of a joint clamped to its limits."""
+    lim = joint_limits(doc, asset_id)[joint_index]
+    return float(angle) if lim is None else min(max(float(angle), lim[0]), lim[1])
+
+
+def clamp_values(doc: Document, values: dict[str, float], time: float) -> dict[str, float]:
+    """Channel ``values`` with every 2D joint angle clamped to its joint's limits (other
+    channels as they are). A dynamic joint's channel holds its world angle: its local
+    angle, relative to the parent's world angle at ``time`` with the new values, is clamped."""
+    by_asset: dict[str, list[tuple[str, int]]] = {}
+    for cid in values:
+        asset_id, joint_name, dof = split_channel_id(cid)
+        if dof != "angle" or not joint_name:
+            continue
+        asset = doc.assets.get(asset_id)
+        if asset is None or asset.kind != ASSET_KIND:
+            continue
+        ch = character(doc, asset_id)
+        if joint_name in {j.name for j in ch.joints}:
+            by_asset.setdefault(asset_id, []).append((cid, ch.joint_index(joint_name)))
+    out = dict(values)
+    for asset_id, items in by_asset.items():
+        limits = joint_limits(doc, asset_id)
+        if not any(limits[k] is not None for _cid, k in items):
+            continue
+        ch = character(doc, asset_id)
+        dynamic_new: dict[int, str] = {}
+        for cid, k in items:
+            lim = limits[k]
+            if ch.joints[k].is_dynamic:
+                dynamic_new[k] = cid
+            elif lim is not None:
+                out[cid] = min(max(float(out[cid]), lim[0]), lim[1])
+        if not any(limits[k] is not None for k in dynamic_new):
+            continue
+        # Parents' world angles with the new values; dynamic joints keep their world angle.
+        old_world = evaluate_pose(doc, asset_id, time).world_angles
+        local = {k: float(out[cid]) for cid, k in items if not ch.joints[k].is_dynamic}
+        angles = joint_angles(doc, asset_id, time)
+        world = np.empty(len(ch.joints))
+        for k, j in enumerate(ch.joints):
+            parent = 0.0 if j.parent is None else float(world[j.parent])
+            if k in dynamic_new:
+                lim = limits[k]
+                theta = float(out[dynamic_new[k]])
+                if lim is not None:
+                    theta = parent + min(max(theta - parent, lim[0]), lim[1])
+                    out[dynamic_new[k]] = theta
+                world[k] = theta
+            elif j.is_dynamic:
+                world[k] = old_world[k]
+            else:
+                world[k] = parent + local.get(k, float(angles[k]))
+    return out
+
+
 def _value(doc: Document, cid: str, time: float, derivative: int = 0) -> float:
     if derivative == 0:
         held = pending_value(doc, cid, time)  # an unkeyed pose shown at this time
@@ -153,9 +298,18 @@ def translation(doc: Document, asset_id: str, time: float, derivative: int = 0) 
 
 
 def keyframed_angles(doc: Document, asset_id: str, time: float, derivative: int = 0) -> FloatArray:
-    """Channel values (J,) of every joint (dynamic joints' channels hold world angles)."""
+    """Channel values (J,) of every joint (dynamic joints' channels hold world angles),
+    keyframed joints clamped to their limits (a derivative is 0 where the value is clamped)."""
     ch = character(doc, asset_id)
-    return np.array([_value(doc, angle_channel_id(asset_id, j.name), time, derivative) for j in ch.joints])
+    out = np.array([_value(doc, angle_channel_id(asset_id, j.name), time, derivative) for j in ch.joints])
+    for k, lim in enumerate(joint_limits(doc, asset_id)):
+        if lim is None or ch.joints[k].is_dynamic:
+            continue
+        if derivative == 0:
+            out[k] = min(max(float(out[k]), lim[0]), lim[1])
+        elif not lim[0] <= _value(doc, angle_channel_id(asset_id, ch.joints[k].name), time) <= lim[1]:
+            out[k] = 0.0
+    return out
 
 
 def _local_from_world_dynamic(ch: Character, angles: FloatArray, dyn_world: FloatArray) -> FloatArray:
@@ -175,6 +329,14 @@ def joint_angles(doc: Document, asset_id: str, time: float, block: bool = True) 
     this thread (see :meth:`PendulumCache.latest_state`)."""
     ch = character(doc, asset_id)
     angles = keyframed_angles(doc, asset_id, time)
+    if ch.spring.any():
+        # Spring joints show (1 − mix)·key + mix·spring; a pose held without a key shows as posed.
+        state = simulation(doc).world_angles(asset_id, time, wait=block)
+        mix = spring_params(doc, asset_id).mix
+        held_spring = pending_values(doc, time)
+        for k in np.flatnonzero(ch.spring):
+            if angle_channel_id(asset_id, ch.joints[int(k)].name) not in held_spring:
+                angles[k] = (1.0 - mix) * angles[k] + mix * state[k]
     if ch.dynamic.any():
         world = simulation(doc).world_angles(asset_id, time, wait=block)
         held = pending_values(doc, time)
@@ -185,6 +347,12 @@ def joint_angles(doc: Document, asset_id: str, time: float, block: bool = True) 
                 if v is not None:
                     world[k] = v
         angles = _local_from_world_dynamic(ch, angles, world)
+    if not block and ch.simulated.any():
+        # A view may read a state the worker has not caught up with (its parent already at
+        # this time): keep the shown local angles in their limits, as the simulation does.
+        for q, lim in enumerate(joint_limits(doc, asset_id)):
+            if lim is not None and ch.simulated[q]:
+                angles[q] = min(max(float(angles[q]), lim[0]), lim[1])
     return angles
 
 
@@ -225,21 +393,22 @@ def key_values(doc: Document, values: dict[str, float], time: float, text: str,
                gesture: Hashable | None = None) -> Command:
     """Key channel ``values`` at ``time`` — the one place a 2D edit becomes keys. With
     key-all (``animation.key_all``) the edit sets the universal keyframe: every keyframed
-    joint and position of every 2D character keyed at ``time`` as well."""
-    keys = {cid: _key(time, v) for cid, v in values.items()}
+    joint and position of every 2D character keyed at ``time`` as well. Joint angles are
+    clamped to their limits (:func:`clamp_values`)."""
+    keys = {cid: _key(time, v) for cid, v in clamp_values(doc, values, time).items()}
     if keys and bool(doc.parameter(KEY_ALL_PARAMETER, False)):
-        merged = _key_all_values(doc, time)
+        merged = _key_all_values(doc, time)  # evaluated: already within the limits
         merged.update(keys)
         keys = merged
     return SetKeys(doc, keys, text=text, gesture=gesture)
 
 
 def joint_value(doc: Document, asset_id: str, joint_index: int, angle: float, time: float) -> dict[str, float]:
-    """The channel value that poses a joint at local ``angle`` (a dynamic joint's channel
-    holds the matching world angle)."""
+    """The channel value that poses a joint at local ``angle``, clamped to the joint's
+    limits (a dynamic joint's channel holds the matching world angle)."""
     ch = character(doc, asset_id)
     j = ch.joints[joint_index]
-    value = float(angle)
+    value = clamp_angle(doc, asset_id, joint_index, angle)
     if j.is_dynamic and j.parent is not None:
         # The parent's world angle needs the simulation only under a dynamic ancestor.
         exact = bool(ch.dynamic[ch.ancestors(j.parent)].any())
@@ -281,15 +450,15 @@ def ik_values(doc: Document, asset_id: str, joint_index: int, local_point: npt.A
         # The chain's pose needs only its own (keyframed) angles: no simulation to run.
         before = keyframed_angles(doc, asset_id, time)
     position = translation(doc, asset_id, time)
-    if str(ik_setting(doc, "ik.solver")) == "handout":
-        after = gradient_descent_step(ch, before, position, joint_index, local_point, target,
-                                      step=float(ik_setting(doc, "ik.handout_step")),
-                                      iterations=int(ik_setting(doc, "ik.handout_iterations")))
-    else:
-        after = solve_ik(ch, before, position, joint_index, local_point, target, limits=limits,
-                         freeze_root=bool(ik_setting(doc, "ik.freeze_root")),
-                         max_iterations=int(ik_setting(doc, "ik.max_iterations")),
-                         damping=float(ik_setting(doc, "ik.damping")))
+    # The joints' limits (joint_limits) unless the caller gives its own; IK never moves a
+    # dynamic joint, so those are left free for the solver.
+    lim = (limits_array(doc, asset_id) if limits is None
+           else np.array(limits, dtype=np.float64).reshape(len(ch.joints), 2))
+    lim[ch.dynamic] = (-math.inf, math.inf)
+    limits = lim
+    after = solve_character(doc, ch, before, position, joint_index, local_point, target, limits)
+    # Whatever the solver, the result is within the limits (every solver clamps what it moves).
+    after = np.where(ch.dynamic, after, np.clip(after, lim[:, 0], lim[:, 1]))
     return {angle_channel_id(asset_id, j.name): float(after[k])
             for k, j in enumerate(ch.joints)
             if not j.is_dynamic and abs(after[k] - before[k]) > 1e-12}
@@ -347,6 +516,55 @@ def set_pendulum_preset(doc: Document, asset_id: str, name: str) -> Command:
     return Macro(f"Pendulum preset: {name}", cmds)
 
 
+def spring_params(doc: Document, asset_id: str) -> SpringParams:
+    """The spring joints' constants of a character: its preset (``soft`` when unset) with
+    the parameters ``"<asset>.spring.<name>"`` over it."""
+    prefix = f"{asset_id}.spring."
+    values = {k[len(prefix):]: v for k, v in list(doc.parameters.items()) if k.startswith(prefix)}
+    preset = SPRING_PRESETS.get(str(values.pop("preset", "soft")), SPRING_PRESETS["soft"])
+    try:
+        return SpringParams.from_dict({**preset.to_dict(), **values})
+    except (TypeError, ValueError):
+        return preset
+
+
+def set_spring_preset(doc: Document, asset_id: str, name: str) -> Command:
+    """Set all of a character's spring constants to a named preset (one undo step)."""
+    if name not in SPRING_PRESETS:
+        raise ValueError(f"unknown spring preset '{name}' (known: {', '.join(SPRING_PRESETS)})")
+    prefix = f"{asset_id}.spring."
+    cmds: list[Command] = [SetParameter(doc, prefix + "preset", name)]
+    for k, v in SPRING_PRESETS[name].to_dict().items():
+        cmds.append(SetParameter(doc, prefix + k, v))
+    return Macro(f"Spring preset: {name}", cmds)
+
+
+def _keyed_angles_at(channels: dict[str, Channel], asset_id: str, ch: Character, times: FloatArray,
+                     limits: list[tuple[float, float] | None]) -> FloatArray:
+    """(3, len(times), J): every non-dynamic joint's keyed local angle, rate and acceleration
+    at ``times``, clamped to its limits (still while clamped), as ``_advance`` reads them."""
+    out = np.zeros((3, len(times), len(ch.joints)))
+    for k, j in enumerate(ch.joints):
+        if j.is_dynamic:
+            continue
+        chn = channels.get(angle_channel_id(asset_id, j.name))
+        if chn is not None and chn.keys:
+            for d in range(3):
+                out[d, :, k] = chn.evaluate(times, d)
+        lim = limits[k]
+        if lim is not None:
+            held = (out[0, :, k] < lim[0]) | (out[0, :, k] > lim[1])
+            out[0, :, k] = np.clip(out[0, :, k], lim[0], lim[1])
+            out[1:, held, k] = 0.0
+    return out
+
+
+def _new_sim(doc: Document, asset_id: str, ch: Character) -> _AssetSim:
+    limits = joint_limits(doc, asset_id) if ch.simulated.any() else None
+    return _AssetSim(ch, pendulum_params(doc, asset_id), limits,
+                     spring_params(doc, asset_id) if ch.spring.any() else None)
+
+
 # ------------------------------------------------------------ simulation cache
 class _AssetSim:
     """One character's simulation: the system, its per-frame states and a kinematics plan.
@@ -358,8 +576,14 @@ class _AssetSim:
     accelerations are only needed at the groups' top joints: one term per (top, ancestor).
     """
 
-    def __init__(self, ch: Character, params: PendulumParams) -> None:
-        self.system = PendulumSystem(ch, params)
+    def __init__(self, ch: Character, params: PendulumParams,
+                 limits: list[tuple[float, float] | None] | None = None,
+                 springs: SpringParams | None = None) -> None:
+        self.system = PendulumSystem(ch, params, limits)
+        #: The spring joints (None without any); their entries of ``theta`` / ``omega`` are
+        #: their simulated local angles and rates.
+        self.springs = (SpringSystem(ch, springs, limits, params.restitution)
+                        if springs is not None and ch.spring.any() else None)
         self.theta: list[FloatArray] = []  # per frame (world angles, J)
         self.omega: list[FloatArray] = []
         #: Bumped by an invalidation that reaches the frame being computed (see PendulumCache).
@@ -397,14 +621,62 @@ class _AssetSim:
         self.pair_vec = np.array(vec, dtype=np.float64).reshape(-1, 2)
         self.pair_sum = np.zeros((len(self.tops), len(anc)))
         self.pair_sum[self.pair_top, np.arange(len(anc))] = 1.0
+        parents = np.array([-1 if j.parent is None else j.parent for j in ch.joints], dtype=np.intp)
+        self.has_parent = parents >= 0
+        self.parent_of = np.maximum(parents, 0)
+
+    def spring_substep(self, s: int, theta: FloatArray, omega: FloatArray, tau: float, ang: FloatArray,
+                       mid: FloatArray, tacc_mid: FloatArray, w_key: FloatArray, r_key: FloatArray,
+                       a_key: FloatArray) -> None:
+        """Step the spring joints over sub-step ``s`` (their entries of ``theta`` and
+        ``omega``), then put their shown angles into the keyed kinematics of sub-step ``s``
+        (``w_key``, ``r_key``, ``a_key``) that the pendulums read."""
+        springs = self.springs
+        assert springs is not None
+        q = springs.joints
+        before_t, before_w = theta[q].copy(), omega[q].copy()
+        key, key_rate, key_acc = mid[0, s].copy(), mid[1, s].copy(), mid[2, s].copy()
+        springs.step(theta, omega, tau, key, key_rate, key_acc, theta, omega, tacc_mid[s])
+        mix = springs.params.mix
+        if mix:
+            avg_acc = (omega[q] - before_w) / tau
+            cols = self.key_sum[:, q]
+            w_key[s] += cols @ (mix * (before_t - ang[0, s, q]))
+            r_key[s] += cols @ (mix * (before_w - ang[1, s, q]))
+            a_key[s] += cols @ (mix * (avg_acc - ang[2, s, q]))
+
+    def parent_motion(self, s: int, theta: FloatArray, omega: FloatArray, w_key: FloatArray, r_key: FloatArray,
+                      ang: FloatArray, end: FloatArray) -> FloatArray:
+        """(J, 4): the keyed part of every joint's parent's world angle and rate at the
+        start and end of sub-step ``s`` (``PendulumSystem.step``'s ``parent_motion``), the
+        springs stepped already. ``end`` (3, J): the keyed angles at the frame's end."""
+        n = len(self.has_parent)
+        nxt = end if s + 1 >= len(w_key) else ang[:, s + 1]
+        w1 = nxt[0] @ self.key_sum.T
+        r1 = nxt[1] @ self.key_sum.T
+        if self.springs is not None and self.springs.params.mix:
+            # Springs after this sub-step (what the next sub-step's correction will add).
+            q = self.springs.joints
+            mix = self.springs.params.mix
+            cols = self.key_sum[:, q]
+            w1 = w1 + cols @ (mix * (theta[q] - nxt[0, q]))
+            r1 = r1 + cols @ (mix * (omega[q] - nxt[1, q]))
+        out = np.zeros((n, 4))
+        p, has = self.parent_of, self.has_parent
+        out[has, 0] = w_key[s][p[has]]
+        out[has, 1] = r_key[s][p[has]]
+        out[has, 2] = w1[p[has]]
+        out[has, 3] = r1[p[has]]
+        return out
 
 
 class PendulumCache:
     """Per-frame pendulum states of every 2D character, at a fixed internal step.
 
     Frame f (from the project's ``frame_start``) holds the world angles after simulating up
-    to time f / fps. A channel edit drops the frames from the edited time on (once per asset
-    and change); a parameter or asset change drops that character's frames.
+    to time f / fps (a spring joint's entry is its simulated local angle and rate). A channel
+    edit drops the frames from the edited time on (once per asset and change); a parameter
+    or asset change drops that character's frames.
 
     Two ways to read:
 
@@ -494,6 +766,10 @@ class PendulumCache:
                     dropped |= self._drop_all()
                 elif ".pendulum." in path:
                     dropped |= self._drop(path.split(".pendulum.", 1)[0])
+                elif ".spring." in path:
+                    dropped |= self._drop(path.split(".spring.", 1)[0])
+                elif ".limits." in path:  # clamped parents swing the pendulums differently
+                    dropped |= self._drop(path.split(".limits.", 1)[0])
             for asset_id in change.channel_assets():
                 # One invalidation per asset and command, from its earliest edited time.
                 dropped |= self._invalidate_locked(doc, asset_id, change.channel_time_from(asset_id))
@@ -571,7 +847,7 @@ class PendulumCache:
                 epoch = self._epoch
             if sim is not None:
                 return sim
-            built = _AssetSim(character(doc, asset_id), pendulum_params(doc, asset_id))
+            built = _new_sim(doc, asset_id, character(doc, asset_id))
             with self._lock:
                 if self._epoch == epoch:  # else a change dropped it meanwhile: build again
                     return self._sims.setdefault(asset_id, built)
@@ -710,7 +986,7 @@ class PendulumCache:
                 with self._lock:
                     self._targets.pop(aid, None)
                 return True
-            built = _AssetSim(ch, pendulum_params(doc, aid))
+            built = _new_sim(doc, aid, ch)
             with self._lock:
                 if self._epoch == epoch and aid not in self._sims:
                     self._sims[aid] = built
@@ -750,7 +1026,7 @@ class PendulumCache:
     def _initial(self, doc: Document, asset_id: str, sim: _AssetSim) -> tuple[FloatArray, FloatArray]:
         ch = sim.system.character
         t0 = doc.frame_range[0] / doc.fps
-        return _initial_angles(doc, asset_id, ch, t0), np.zeros(len(ch.joints))
+        return _initial_angles(doc, asset_id, ch, t0), _initial_rates(doc, asset_id, ch, t0)
 
     def _advance(self, doc: Document, asset_id: str, sim: _AssetSim, frame: int, theta0: FloatArray,
                  omega0: FloatArray) -> tuple[FloatArray, FloatArray, int]:
@@ -769,6 +1045,8 @@ class PendulumCache:
         dyn_idx = np.flatnonzero(ch.dynamic)
         # Channel values and derivatives at every sub-step time, evaluated at once.
         ang = np.zeros((3, n_steps, len(ch.joints)))
+        stored = doc.parameters
+        limits = [_limit_pair(stored.get(limits_parameter(asset_id, j.name))) for j in ch.joints]
         for k, j in enumerate(ch.joints):
             if j.is_dynamic:
                 continue
@@ -776,6 +1054,11 @@ class PendulumCache:
             if chn is not None and chn.keys:
                 for d in range(3):
                     ang[d, :, k] = chn.evaluate(times, d)
+            lim = limits[k]
+            if lim is not None:  # as keyframed_angles: clamped, still while clamped
+                held = (ang[0, :, k] < lim[0]) | (ang[0, :, k] > lim[1])
+                ang[0, :, k] = np.clip(ang[0, :, k], lim[0], lim[1])
+                ang[1:, held, k] = 0.0
         cx, cy = position_channel_ids(asset_id)
         tacc = np.zeros((n_steps, 2))
         for col, cid in enumerate((cx, cy)):
@@ -786,10 +1069,24 @@ class PendulumCache:
         w_key = ang[0] @ sim.key_sum.T
         r_key = ang[1] @ sim.key_sum.T
         a_key = ang[2] @ sim.key_sum.T
+        springs, bounded = sim.springs, bool(system.bounded.any())
+        mid, tacc_mid, end = ang, tacc, ang[:, 0]
+        if springs is not None:  # keys and the body's acceleration at the sub-steps' midpoints
+            mids = np.asarray(times + 0.5 * tau, dtype=np.float64)
+            mid = _keyed_angles_at(channels, asset_id, ch, mids, limits)
+            tacc_mid = np.zeros((n_steps, 2))
+            for col, cid in enumerate((cx, cy)):
+                chn = channels.get(cid)
+                if chn is not None and chn.keys:
+                    tacc_mid[:, col] = chn.evaluate(mids, 2)
+        if bounded:  # limits: the parents' motion to the frame's end
+            end = _keyed_angles_at(channels, asset_id, ch, np.array([t1]), limits)[:, 0]
         tacc = tacc * params.accel_scale
         pa = np.zeros((len(ch.joints), 2))
         rs = params.rotation_accel_scale
         for s in range(n_steps):
+            if springs is not None:
+                sim.spring_substep(s, theta, omega, tau, ang, mid, tacc_mid, w_key, r_key, a_key)
             if len(sim.pair_anc):
                 world = w_key[s] + sim.dyn_pick @ theta
                 rate = r_key[s] + sim.dyn_pick @ omega
@@ -802,7 +1099,8 @@ class PendulumCache:
                 pa[sim.tops] = tacc[s] + sim.pair_sum @ contrib
             else:
                 pa[sim.tops] = tacc[s]
-            system.step(theta, omega, pa, tau)
+            motion = sim.parent_motion(s, theta, omega, w_key, r_key, ang, end) if bounded else None
+            system.step(theta, omega, pa, tau, motion)
         # Keys on a dynamic joint's channel pose the pendulum at that frame.
         for kd in dyn_idx:
             k = int(kd)
@@ -817,14 +1115,28 @@ class PendulumCache:
 
 
 def _initial_angles(doc: Document, asset_id: str, ch: Character, t0: float) -> FloatArray:
-    """The simulation's start state: dynamic joints' keyed world angles at ``t0`` (else 0)."""
+    """The simulation's start state: dynamic joints' keyed world angles at ``t0`` (else 0),
+    spring joints on their keyed local angle (clamped to their limits)."""
     theta = np.zeros(len(ch.joints))
     for k, j in enumerate(ch.joints):
         if j.is_dynamic:
             chn = doc.channels.get(angle_channel_id(asset_id, j.name))
             if chn is not None and chn.keys:
                 theta[k] = float(chn.evaluate(t0))
+    if ch.spring.any():
+        limits = joint_limits(doc, asset_id)
+        keyed = _keyed_angles_at(doc.channels, asset_id, ch, np.array([t0]), limits)
+        theta[ch.spring] = keyed[0, 0, ch.spring]
     return theta
+
+
+def _initial_rates(doc: Document, asset_id: str, ch: Character, t0: float) -> FloatArray:
+    """The start rates: 0 for pendulums; spring joints move with their keys."""
+    omega = np.zeros(len(ch.joints))
+    if ch.spring.any():
+        keyed = _keyed_angles_at(doc.channels, asset_id, ch, np.array([t0]), joint_limits(doc, asset_id))
+        omega[ch.spring] = keyed[1, 0, ch.spring]
+    return omega
 
 
 PENDULUM_CACHE = "pendulums"
@@ -846,7 +1158,7 @@ def simulation_ready(doc: Document, times: float | Iterable[float]) -> bool:
     ts = [float(times)] if isinstance(times, (int, float)) else [float(t) for t in times]
     for aid in character_assets(doc):
         ch = doc.runtime.get(aid)
-        if not isinstance(ch, Character) or not ch.dynamic.any():
+        if not isinstance(ch, Character) or not ch.simulated.any():
             continue
         if not isinstance(cache, PendulumCache) or not all(cache.ready(aid, t) for t in ts):
             return False
@@ -861,7 +1173,7 @@ def simulated_frames(doc: Document) -> tuple[int, int] | None:
     counts = []
     for aid in character_assets(doc):
         ch = doc.runtime.get(aid)
-        if isinstance(ch, Character) and ch.dynamic.any():
+        if isinstance(ch, Character) and ch.simulated.any():
             counts.append(cache.cached_frames(aid) if isinstance(cache, PendulumCache) else 0)
     if not counts:
         return None

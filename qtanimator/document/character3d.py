@@ -581,12 +581,13 @@ def set_dofs_command(doc: Document, asset_id: str, values: Mapping[tuple[int | N
 def ik_values(doc: Document, asset_id: str, joint: int, target: npt.ArrayLike, time: float,
               dofs: list[tuple[int, int]]) -> dict[tuple[int | None, str | int], float]:
     """Solve IK for ``joint`` towards ``target`` over ``dofs`` from the pose shown at
-    ``time``: the new DOF values by (joint, axis). Both 3D IK paths (keying and posing
-    without keys) get their values here."""
-    from qtanimator.core.ik3d import solve_ik
+    ``time`` with the document's IK settings (:mod:`qtanimator.document.ik_settings`: the
+    solver, two-bone for a two-joint chain): the new DOF values by (joint, axis). Both 3D
+    IK paths (keying and posing without keys) get their values here."""
+    from qtanimator.document.ik_settings import solve_skeleton
 
     skel = pose_skeleton(doc, asset_id, time)
-    result = solve_ik(skel, joint, np.asarray(target, dtype=np.float64), dofs=dofs)
+    result = solve_skeleton(doc, skel, joint, np.asarray(target, dtype=np.float64), dofs)
     return {(j, axis): v for (j, axis), v in result.by_axis_name().items()}
 
 

@@ -490,7 +490,8 @@ def paste_values(doc: Document, clip: PoseClip, asset_id: str, mirrored: bool = 
                  time: float | None = None) -> dict[str, float]:
     """The channel values pasting ``clip`` onto ``asset_id`` sets (joints the character
     does not have are left out). Mirrored: each joint's values go to its mirror-named
-    joint (itself when it has no side), mirrored by :func:`mirrored_value`."""
+    joint (itself when it has no side), mirrored by :func:`mirrored_value`. Values are
+    clamped to the target joints' limits (2D and 3D)."""
     kind = _kind(doc, asset_id)
     if kind != clip.kind:
         return {}
@@ -507,7 +508,8 @@ def paste_values(doc: Document, clip: PoseClip, asset_id: str, mirrored: bool = 
             value = float(dofs["angle"])
             out[c2d.angle_channel_id(asset_id, target)] = (
                 mirrored_value(kind, "angle", value, negate_2d=negate) if mirrored else value)
-        return out
+        # Clamped to the target joints' limits (a pendulum's local angle at ``time``).
+        return c2d.clamp_values(doc, out, 0.0 if time is None else time)
     c3d = _c3d()
     runtime = c3d.character(doc, asset_id)
     keys = list(runtime.joint_keys)

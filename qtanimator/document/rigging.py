@@ -81,6 +81,7 @@ def _same_elements(ch: Character, spec: dict[str, Any]) -> Character:
     for j in ch.joints:
         r = rows[j.name]
         joints.append(replace(j, pivot=np.array(r["pivot"], dtype=np.float64), is_dynamic=bool(r["dynamic"]),
+                              is_spring=bool(r.get("spring", False)),
                               children=[], mass_properties=None, reference_mass_properties=None))
     out = Character(ch.name, joints, source=ch.source, warnings=ch.warnings)
     out.joint_candidates = list(ch.joint_candidates)
@@ -201,9 +202,38 @@ def set_dynamic_command(doc: Document, asset_id: str, joint: str, dynamic: bool)
     if row.get("parent") is None and dynamic:
         raise RigError("the root joint cannot be dynamic: a pendulum hangs from a parent.")
     row["dynamic"] = bool(dynamic)
+    row.pop("spring", None)
     _replace_row(spec, row)
     return SetRig(doc, asset_id, spec, f"Mark {joint} {'Dynamic' if dynamic else 'Keyframed'}",
                   runtime=_same_elements(character(doc, asset_id), spec))
+
+
+#: What drives a joint: its keys, a pendulum, or a spring that follows its keys.
+JOINT_MODES = ("keyframed", "dynamic", "spring")
+
+
+def joint_mode(doc: Document, asset_id: str, joint: str) -> str:
+    """``keyframed``, ``dynamic`` or ``spring``."""
+    ch = character(doc, asset_id)
+    j = ch.joints[ch.joint_index(joint)]
+    return "dynamic" if j.is_dynamic else "spring" if j.is_spring else "keyframed"
+
+
+def set_joint_mode_command(doc: Document, asset_id: str, joint: str, mode: str) -> SetRig:
+    """Make a joint keyframed, dynamic (a pendulum; not the root) or a spring joint (its
+    local angle follows its keys through a damped spring). The rig spec row gets
+    ``"spring": true`` for a spring joint, as ``"dynamic"`` marks a pendulum; the joint's
+    channel is kept as it is."""
+    if mode not in JOINT_MODES:
+        raise RigError(f"unknown joint mode '{mode}' (known: {', '.join(JOINT_MODES)}).")
+    if mode != "spring":
+        return set_dynamic_command(doc, asset_id, joint, mode == "dynamic")
+    spec = rig_spec(doc, asset_id)
+    row = _row(spec, joint)
+    row["dynamic"] = False
+    row["spring"] = True
+    _replace_row(spec, row)
+    return SetRig(doc, asset_id, spec, f"Make {joint} a Spring", runtime=_same_elements(character(doc, asset_id), spec))
 
 
 def reparent_command(doc: Document, asset_id: str, joint: str, parent: str) -> SetRig:

@@ -18,8 +18,11 @@
 Tokens are whitespace separated, braces may be glued to words (``channel 14{``), any
 line endings (LF, CRLF, ``\\r\\r\\n``, bare CR) are accepted. ``numchannels`` may be
 missing or misplaced; when present it must match the number of channels read.
-Tangents are ``flat | linear | smooth`` or a fixed slope (value per second); ``clamped``
-(qtanimator's own rule) is accepted and written too.
+Tangents are ``flat | linear | smooth`` or a fixed slope (value per second); ``clamped``,
+``centripetal`` and ``chordal`` (qtanimator's own rules) are accepted and written too. A
+TCB (Kochanek–Bartels) side needs its key's tension, continuity and bias, which the format
+cannot hold: it is written as the fixed slope it resolves to (the same curve), with an
+:class:`AnimExportWarning`.
 
 The format has no handle lengths: a channel with weighted tangents (issue 13) is written
 as its :meth:`~qtanimator.core.channel.Channel.unweighted` equivalent (keys added on each
@@ -31,6 +34,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -47,7 +51,7 @@ class AnimExportWarning(UserWarning):
 
 
 _EXTRAPOLATIONS = {e.value for e in Extrapolation}
-_RULES = {"flat", "linear", "smooth", "clamped"}
+_RULES = {"flat", "linear", "smooth", "clamped", "centripetal", "chordal"}
 
 
 def load_anim(path: str | os.PathLike[str]) -> AnimationClip:
@@ -174,7 +178,8 @@ def _tangent(tk: Tokens, what: str) -> Tangent | float:
     try:
         slope = float(word)
     except ValueError:
-        tk.error(f"expected flat, linear, smooth or a number for {what}, found '{show(word)}'.", tk.pos - 1)
+        tk.error(f"expected flat, linear, smooth, clamped, centripetal, chordal or a number for {what}, "
+                 f"found '{show(word)}'.", tk.pos - 1)
     if slope != slope or slope in (float("inf"), float("-inf")):
         tk.error(f"{what} must be a finite number, found '{show(word)}'.", tk.pos - 1)
     return slope
@@ -192,6 +197,19 @@ def _tangent_text(rule: Tangent, slope: float) -> str:
     return _num(slope) if rule is Tangent.FIXED else rule.value
 
 
+def _tcb_as_fixed(ch: Channel) -> Channel:
+    """The channel with every TCB side replaced by the fixed slope it resolves to."""
+    s_in, s_out = ch.slopes()
+    keys = []
+    for i, k in enumerate(ch.keys):
+        if k.in_tangent is Tangent.TCB:
+            k = replace(k, in_tangent=Tangent.FIXED, in_slope=float(s_in[i]))
+        if k.out_tangent is Tangent.TCB:
+            k = replace(k, out_tangent=Tangent.FIXED, out_slope=float(s_out[i]))
+        keys.append(k)
+    return ch.with_keys(keys)
+
+
 def format_anim(clip: AnimationClip) -> str:
     """The clip as ``.anim`` text (numbers written exactly: load gives the same floats).
 
@@ -207,6 +225,10 @@ def format_anim(clip: AnimationClip) -> str:
             ch, added, worst = ch.unweighted()
             warnings.warn(f"channel {i} has weighted tangents, which .anim files cannot hold: written with "
                           f"{added} added keys (within {worst:.1g} of the curve).", AnimExportWarning, stacklevel=2)
+        if any(Tangent.TCB in (k.in_tangent, k.out_tangent) for k in ch.keys):
+            ch = _tcb_as_fixed(ch)
+            warnings.warn(f"channel {i} has TCB tangents, which .anim files cannot hold: written as the fixed "
+                          "slopes they give (the same curve).", AnimExportWarning, stacklevel=2)
         out.append(f"\tchannel {i} {{")
         out.append(f"\t\textrapolate {ch.pre.value} {ch.post.value}")
         out.append(f"\t\tkeys {len(ch.keys)} {{")

@@ -26,7 +26,9 @@ cubic) and ``broken`` (left out when false), each written once when every key sh
 and as one entry per key otherwise. Handle lengths of weighted tangents (issue 13) are the
 columns ``in_weight`` / ``out_weight`` (seconds; ``null`` for a key without one), written
 only when some key of the channel has one, so a project without weights is written exactly
-as before. Number columns are written :data:`NUMBERS_PER_LINE` to a line. Version 1 wrote
+as before; the Kochanek–Bartels columns ``tension`` / ``continuity`` / ``bias`` (issue 18)
+likewise only when some key has one that is not 0. Number columns are written
+:data:`NUMBERS_PER_LINE` to a line. Version 1 wrote
 one object per key, ``"keys": [{"t": 0.0, "v": 0.5, "in": "smooth", "out": "smooth"},
 ...]``; that form is still read.
 

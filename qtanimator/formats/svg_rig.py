@@ -390,7 +390,14 @@ class _Builder:
         if width < 0:
             width = _float(getattr(el, "stroke_width", 1.0), 1.0)
         opacity = min(max(_float(values.get("opacity", 1.0), 1.0), 0.0), 1.0)
-        style: dict[str, Any] = {"fill": fill, "stroke": stroke, "stroke_width": width, "opacity": opacity}
+        # Opacity is a look, not a mass: only the element's own ``opacity`` (attribute, style
+        # or CSS rule) sets its density, as in the reference program, which ignores group
+        # styles; a group's opacity (owl.svg's wing feathers) changes nothing.
+        attributes = values.get("attributes")
+        own = attributes.get("opacity", 1.0) if isinstance(attributes, dict) else 1.0
+        density_opacity = min(max(_float(own, 1.0), 0.0), 1.0)
+        style: dict[str, Any] = {"fill": fill, "stroke": stroke, "stroke_width": width, "opacity": opacity,
+                                 "density_opacity": density_opacity}
         m = _matrix(el)
         if isinstance(el, se.Ellipse) or type(el).__name__ == "Circle":
             rx, ry = _float(getattr(el, "rx", 0.0)), _float(getattr(el, "ry", 0.0))
@@ -808,7 +815,7 @@ def _clips_as_masks(root: ET.Element) -> None:
 #: Rig spec (the asset property ``rig``; ``docs/decisions.md``, "Rigging inside the program"):
 #:
 #:     {"joints": [{"name": str, "parent": str | None, "elements": [ref, ...],
-#:                  "pivot": [x, y] | None, "dynamic": bool}, ...],
+#:                  "pivot": [x, y] | None, "dynamic": bool, "spring": bool (optional)}, ...],
 #:      "hidden": [ref, ...]}
 #:
 #: A ref names an element of the SVG: its ``id`` when that id is unique in the file, else
@@ -983,13 +990,14 @@ def _from_spec(svg: Any, top: list[Any], root: ET.Element, spec: Any, refs: dict
             pivot = _box_centre(pts) if pts else np.zeros(2)
         parent = None if r.get("parent") is None else index[r["parent"]]
         builder._names.add(name)
-        builder.joints.append(Joint(name, parent, pivot, bool(r.get("dynamic", False)), shapes))
+        builder.joints.append(Joint(name, parent, pivot, bool(r.get("dynamic", False)), shapes,
+                                    is_spring=bool(r.get("spring", False))))
         builder.scopes.append((keep, others))
     _add_candidates(builder, top, root)
     builder.spec = {"joints": [{"name": r["name"], "parent": r.get("parent"),
                                 "elements": [refs[q] for q in own[r["name"]]],
                                 "pivot": [float(j.pivot[0]), float(j.pivot[1])],
-                                "dynamic": bool(j.is_dynamic)}
+                                "dynamic": bool(j.is_dynamic), **({"spring": True} if j.is_spring else {})}
                                for r, j in zip(order, builder.joints)],
                     "hidden": [refs[q] for q in sorted(hidden, key=int)]}
     return builder

@@ -83,7 +83,7 @@ def load_scene(path: str | os.PathLike[str]) -> Any:
         from qtanimator.document.character2d import add_characters_command
 
         doc = Document()
-        add_characters_command(doc, p).do(doc)
+        add_characters_command(doc, p, new_project_range=True).do(doc)  # 0…300, as opening it in the GUI
         doc.path = None
         return doc
     raise FormatError(f"qtanimator render reads projects (.qtanim) and SVG characters, not "

@@ -52,7 +52,17 @@ from qtanimator.ui.curves.normalisation import unit_scale
 from qtanimator.ui.curves.tree import ChannelTree
 from qtanimator.ui.curves.view import CurveView
 
-TANGENT_RULES = (Tangent.FLAT, Tangent.LINEAR, Tangent.SMOOTH, Tangent.CLAMPED, Tangent.FIXED)
+TANGENT_RULES = (Tangent.FLAT, Tangent.LINEAR, Tangent.SMOOTH, Tangent.CLAMPED, Tangent.CENTRIPETAL,
+                 Tangent.CHORDAL, Tangent.TCB, Tangent.FIXED)
+_TANGENT_TEXT = {"centripetal": "Centripetal (Catmull-Rom)", "chordal": "Chordal (Catmull-Rom)",
+                 "tcb": "TCB (Kochanek–Bartels)"}
+_TANGENT_TIPS = {
+    "smooth": "Catmull-Rom: the slope between the two neighbouring keys",
+    "centripetal": "Catmull-Rom through the keys as points in time and value, knots spaced by the square "
+                   "root of their distance: follows uneven keys without loops or overshoot spikes",
+    "chordal": "Catmull-Rom through the keys as points in time and value, knots spaced by their distance",
+    "tcb": "Kochanek–Bartels: the key's Tension, Continuity and Bias (fields under the plot) shape its slopes",
+}
 EXTRAPOLATIONS = (Extrapolation.CONSTANT, Extrapolation.LINEAR, Extrapolation.CYCLE,
                   Extrapolation.CYCLE_OFFSET, Extrapolation.BOUNCE)
 _EXTRAP_TEXT = {"constant": "Constant", "linear": "Linear", "cycle": "Cycle",
@@ -162,6 +172,7 @@ class CurveEditor(QWidget):
         self.tangent_groups: dict[str, QActionGroup] = {}
         for side, label in (("both", "In and Out"), ("in", "In"), ("out", "Out")):
             sub = self.tangent_menu.addMenu(label) if side != "both" else self.tangent_menu
+            sub.setToolTipsVisible(True)
             if side == "both":
                 sub.addSection("In and Out")
             else:
@@ -169,8 +180,10 @@ class CurveEditor(QWidget):
             group = self.tangent_groups[side] = QActionGroup(self)
             group.setExclusionPolicy(QActionGroup.ExclusionPolicy.ExclusiveOptional)
             for rule in TANGENT_RULES:
-                act = sub.addAction(rule.value.capitalize())
+                act = sub.addAction(_TANGENT_TEXT.get(rule.value, rule.value.capitalize()))
                 act.setObjectName(f"actionCurveTangent_{side}_{rule.value}")
+                if rule.value in _TANGENT_TIPS:
+                    act.setToolTip(_TANGENT_TIPS[rule.value])
                 act.setCheckable(True)
                 group.addAction(act)
                 act.triggered.connect(lambda _c=False, r=rule, s=side: self.set_tangents(r, s))

@@ -1,5 +1,8 @@
 """File > Export Animation…: a PNG sequence, a GIF or an MP4 of the 2D scene.
 
+File > Export Image Sequence… (``Ctrl+Shift+E``, the CMU animator's ``s``) opens the same
+dialog set to PNG frames.
+
 The dialog picks the format, the output, the image size, the frame rate and the frame
 range; the frames are rendered with the shared 2D renderer and written by
 ``qtanimator.render.export.write_frames`` while a QProgressDialog shows progress and
@@ -258,6 +261,31 @@ def open_export_dialog(window: MainWindow) -> int:
     return run_export(window, settings)
 
 
+def image_sequence_settings(window: MainWindow) -> ExportSettings:
+    """The last export's settings (or the defaults) switched to a PNG sequence: a GIF or video
+    target becomes the default frames folder."""
+    from dataclasses import replace
+
+    previous = getattr(window, "export_settings", None)
+    if isinstance(previous, ExportSettings) and previous.fmt == "png":
+        return previous
+    defaults = default_settings(window.doc)
+    if isinstance(previous, ExportSettings):
+        return replace(previous, fmt="png", out=defaults.out)
+    return defaults
+
+
+def open_image_sequence_dialog(window: MainWindow) -> int:
+    """File > Export Image Sequence…: the export dialog set to PNG frames (the CMU key ``s``)."""
+    dialog = ExportDialog(window.doc, window, image_sequence_settings(window))
+    dialog.setWindowTitle("Export Image Sequence")
+    if dialog.exec() != QDialog.DialogCode.Accepted:
+        return 0
+    settings = dialog.settings()
+    window.export_settings = settings  # type: ignore[attr-defined]
+    return run_export(window, settings)
+
+
 def install(window: MainWindow) -> None:
     action = QAction("&Export Animation…", window)
     action.setObjectName("actionExport")
@@ -265,3 +293,10 @@ def install(window: MainWindow) -> None:
     action.triggered.connect(lambda _checked=False: open_export_dialog(window))
     window.file_menu.insertAction(window.export_separator, action)
     window.action_export = action  # type: ignore[attr-defined]
+    frames = QAction("Export &Image Sequence…", window)
+    frames.setObjectName("actionExportImageSequence")
+    frames.setShortcut(QKeySequence("Ctrl+Shift+E"))
+    frames.setStatusTip("Write the 2D animation as numbered PNG frames (the reference animator's s key)")
+    frames.triggered.connect(lambda _checked=False: open_image_sequence_dialog(window))
+    window.file_menu.insertAction(window.export_separator, frames)
+    window.action_export_frames = frames  # type: ignore[attr-defined]

@@ -151,8 +151,15 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
         def key(value: float, t: float, gesture: object) -> Command:
             return m2.key_joint(doc, asset, index, math.radians(value), t, gesture=gesture)
 
-        return [DofSpec("angle", math.degrees(angle), -360.0, 360.0, key, "°",
-                        m2.angle_channel_id(asset, joint), math.radians)]
+        def preview(value: float, t: float) -> dict[str, float]:
+            # Clamped, and a pendulum's channel holds its world angle (as keying does).
+            return dict(m2.joint_value(doc, asset, index, math.radians(value), t))
+
+        # The slider (and typed values) span the joint's limits when it has some.
+        limit = m2.joint_limits(doc, asset)[index]
+        lo, hi = (-360.0, 360.0) if limit is None else (math.degrees(limit[0]), math.degrees(limit[1]))
+        return [DofSpec("angle", math.degrees(angle), lo, hi, key, "°",
+                        m2.angle_channel_id(asset, joint), math.radians, preview)]
     if m3 is not None and kind == m3.ASSET_KIND and runtime is not None:
         return _dof_specs_3d(m3, doc, asset, joint, time)
     return []

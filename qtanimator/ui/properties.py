@@ -1,4 +1,4 @@
-"""The properties dock: the selected joint and character, pendulum parameters, IK settings.
+"""The properties dock: the selected joint (with its limits) and character, pendulum parameters, IK settings.
 
 Everything editable is a document parameter changed through a command (SetParameter, or
 ``character2d.set_pendulum_preset`` for a preset), or an asset property changed through its
@@ -31,6 +31,7 @@ from PySide6.QtWidgets import (
 from qtanimator.document.character2d import IK_DEFAULTS, ik_setting
 from qtanimator.document.commands import SetParameter
 from qtanimator.document.document import DocumentChange
+from qtanimator.document.ik_settings import BEND_DIRECTIONS, IK_SOLVERS
 from qtanimator.ui.clip_picker import ClipCombo, clip_characters
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.joint_tree import c2d, c3d
@@ -43,6 +44,8 @@ if TYPE_CHECKING:
 PENDULUM_LABELS: dict[str, tuple[str, str]] = {
     "g": ("Gravity", "g, in scene units per second² (pulls down the screen)"),
     "damping": ("Damping", "how fast the swing dies out: a in ω ← ω·e^(−a·τ), per second"),
+    "restitution": ("Bounce", "restitution e: the share of its speed a pendulum or spring joint keeps when it hits "
+                              "its joint limits (0 stops dead, 1 bounces back fully)"),
     "length_scale": ("Length scale", "multiplies the pivot-to-centre-of-mass lengths (the course handout uses 1/1000)"),
     "accel_scale": ("Follow the body", "how much the character's movement swings the pendulums "
                                        "(translation acceleration scale)"),
@@ -54,9 +57,24 @@ PENDULUM_LABELS: dict[str, tuple[str, str]] = {
     "integrator": ("Integrator", "symplectic Euler (the course's), leapfrog or Runge–Kutta 4"),
     "step": ("Simulation step (s)", "the fixed internal time step; smaller is steadier and slower"),
 }
+SPRING_LABELS: dict[str, tuple[str, str]] = {
+    "stiffness": ("Stiffness", "how hard the spring pulls the joint back to its keyed angle (k, per second²; "
+                               "it wobbles at √k / 2π per second)"),
+    "damping": ("Damping", "how fast the wobble dies out (c, per second; none left at 2√k)"),
+    "mix": ("Mix", "0 shows the keys, 1 the spring; in between, a blend"),
+    "inertia": ("Inertia", "how much the parent turning and the body moving drag the joint (0: it rides on its "
+                           "parent, 1: it keeps its heading like a loose part)"),
+}
+#: What drives a 2D joint, in the animator's words (``rigging.JOINT_MODES``).
+JOINT_MODE_LABELS = {"keyframed": "Keys", "dynamic": "Pendulum (physics)", "spring": "Spring (follows keys)"}
 IK_LABELS: dict[str, tuple[str, str]] = {
-    "ik.solver": ("Solver", "dls: damped least squares, respects joint limits (recommended); "
-                            "handout: the course handout's gradient descent"),
+    "ik.solver": ("Solver", "dls: damped least squares (recommended); ccd: cyclic coordinate descent, one joint "
+                            "at a time; fabrik: forward and backward reaching, on positions; handout: the course "
+                            "handout's gradient descent (2D). All respect joint limits"),
+    "ik.two_bone": ("Two-bone chains exactly", "a chain with exactly two moving joints is solved exactly "
+                                               "(law of cosines), whatever the solver"),
+    "ik.bend_direction": ("Two-bone bend", "keep: the middle joint bends to the side it bends to now; "
+                                           "positive / negative: counter-clockwise / clockwise on screen (2D)"),
     "ik.freeze_root": ("Keep the root still", "the dragged chain stops below the character's root joint"),
     "ik.max_iterations": ("Precision (iterations)", "more iterations reach the cursor more exactly"),
     "ik.damping": ("Smoothness", "damped least squares' damping λ: higher is steadier near full stretch"),
@@ -65,7 +83,9 @@ IK_LABELS: dict[str, tuple[str, str]] = {
                                                                           "per mouse move"),
     "ik.gradient_arrow_scale": ("Debug arrow length", "length of the gradient arrows of the debug overlay"),
 }
-IK_CHOICES = {"ik.solver": ["dls", "handout"]}
+IK_CHOICES = {"ik.solver": list(IK_SOLVERS), "ik.bend_direction": list(BEND_DIRECTIONS)}
+#: How far the joint limit fields go either way (degrees): two turns.
+LIMIT_RANGE_DEGREES = 720.0
 
 
 class PropertiesPanel(QWidget):
@@ -128,8 +148,10 @@ class PropertiesPanel(QWidget):
             if joint:
                 layout.addWidget(self._joint2d_group(asset, joint))
             layout.addWidget(self._character2d_group(asset))
-            if bool(doc.runtime[asset].dynamic.any()):
+            if bool(doc.runtime[asset].simulated.any()):
                 layout.addWidget(self._pendulum_group(asset))
+            if bool(doc.runtime[asset].spring.any()):
+                layout.addWidget(self._spring_group(asset))
         elif m3 is not None and kind == m3.ASSET_KIND and asset in doc.runtime:
             layout.addWidget(self._joint3d_group(asset, joint))
         elif not asset:
@@ -255,9 +277,10 @@ class PropertiesPanel(QWidget):
         form.addRow("Index", QLabel(str(index)))
         parent = "—" if j.parent is None else character.joints[j.parent].name
         form.addRow("Parent", QLabel(parent))
-        kind = QLabel("dynamic (pendulum)" if j.is_dynamic else "keyframed")
+        kind = QLabel("dynamic (pendulum)" if j.is_dynamic else "spring" if j.is_spring else "keyframed")
         kind.setObjectName("jointType")
         form.addRow("Type", kind)
+        form.addRow("Driven by", self._joint_mode_editor(asset, joint, index))
         form.addRow("Pivot (rest)", QLabel(f"({j.pivot[0]:.2f}, {j.pivot[1]:.2f})"))
         form.addRow("Shapes", QLabel(str(len(j.shapes))))
         form.addRow("Mass", QLabel(f"{j.mass:.6g}"))
@@ -271,7 +294,85 @@ class PropertiesPanel(QWidget):
             return f"{math.degrees(a):.3f}°"
 
         self._label(form, "Angle (local)", angle, "jointAngle")
+        if j.is_dynamic or j.is_spring:  # the simulation catching up changes it too
+            self._simulation_refreshers.append(self._refreshers[-1])
+        self._joint_limits_editor(form, asset, index)
         return group
+
+    def _joint_limits_editor(self, form: QFormLayout, asset: str, index: int) -> None:
+        """A 2D joint's limits on its local angle, in degrees: the check box turns them on
+        (with a range that holds the angle shown) or off, the fields edit one bound each;
+        every change is one undo step (``character2d.set_joint_limits_command``)."""
+        doc = self.ctx.doc
+        m2 = c2d()
+        assert m2 is not None
+        enabled = QCheckBox("Limit rotation")
+        enabled.setObjectName("jointLimitsEnabled")
+        enabled.setToolTip("keep the joint's angle relative to its parent within a range: IK, dragging, the "
+                           "Joints slider, pasting and playback respect it")
+        boxes = (CheckedDoubleSpinBox(label="Minimum angle"), CheckedDoubleSpinBox(label="Maximum angle"))
+        for box, name, tip in zip(boxes, ("jointLimitMin", "jointLimitMax"),
+                                  ("the smallest local angle (counter-clockwise positive)",
+                                   "the largest local angle (counter-clockwise positive)")):
+            box.setObjectName(name)
+            box.setRange(-LIMIT_RANGE_DEGREES, LIMIT_RANGE_DEGREES)
+            box.setDecimals(2)
+            box.setSuffix("°")
+            box.setSingleStep(5.0)
+            box.setKeyboardTracking(False)
+            box.setToolTip(tip)
+        form.addRow("Limits", enabled)
+        form.addRow("Minimum angle", boxes[0])
+        form.addRow("Maximum angle", boxes[1])
+        self.editors["joint_limits"] = enabled
+
+        def current() -> tuple[float, float] | None:
+            return m2.joint_limits(doc, asset)[index]  # type: ignore[no-any-return]
+
+        def free_range() -> tuple[float, float]:
+            """What the fields offer while the joint is free: ±90° widened to the angle shown."""
+            a = math.degrees(float(np.asarray(m2.joint_angles(doc, asset, self.ctx.time, block=False))[index]))
+            return min(-90.0, math.floor(a)), max(90.0, math.ceil(a))
+
+        def refresh() -> None:
+            limit = current()
+            shown = free_range() if limit is None else (math.degrees(limit[0]), math.degrees(limit[1]))
+            for w in (enabled, *boxes):
+                w.blockSignals(True)
+            enabled.setChecked(limit is not None)
+            for box, value in zip(boxes, shown):
+                box.setEnabled(limit is not None)
+                box.setValue(value)
+            for w in (enabled, *boxes):
+                w.blockSignals(False)
+
+        def toggled(on: bool) -> None:
+            if on:
+                lo, hi = boxes[0].value(), boxes[1].value()
+                if lo > hi:
+                    lo, hi = free_range()
+                command = m2.set_joint_limits_command(doc, asset, index, math.radians(lo), math.radians(hi))
+            else:
+                command = m2.set_joint_limits_command(doc, asset, index, None, None)
+            self.ctx.push(command)
+
+        def edited(which: int) -> None:
+            limit = current()
+            if limit is None:
+                return
+            bounds = list(limit)
+            bounds[which] = math.radians(boxes[which].value())
+            if bounds[0] > bounds[1]:
+                refresh()
+                boxes[which].refuse("The minimum angle cannot be above the maximum angle.")
+                return
+            if tuple(bounds) != limit:
+                self.ctx.push(m2.set_joint_limits_command(doc, asset, index, bounds[0], bounds[1]))
+
+        enabled.toggled.connect(toggled)
+        boxes[0].valueChanged.connect(lambda _v: edited(0))
+        boxes[1].valueChanged.connect(lambda _v: edited(1))
+        self._refreshers.append(refresh)
 
     def _character2d_group(self, asset: str) -> QGroupBox:
         doc = self.ctx.doc
@@ -367,6 +468,98 @@ class PropertiesPanel(QWidget):
         self._simulation_refreshers.append(refresh_problem)
         self._refreshers.append(refresh_problem)
         form.addRow(problem)
+        return group
+
+    def _joint_mode_editor(self, asset: str, joint: str, index: int) -> QComboBox:
+        """Keys, a pendulum or a spring: one undo step (``rigging.set_joint_mode_command``);
+        a refusal (the root cannot swing) goes to the status bar."""
+        from qtanimator.document import rigging
+
+        doc = self.ctx.doc
+        combo = QComboBox()
+        combo.setObjectName("jointMode")
+        combo.setToolTip("keys: the joint follows its keys; pendulum: gravity and the body's movement swing it "
+                         "(its keys only set where it starts); spring: it follows its keys through a damped "
+                         "spring, lagging and overshooting")
+        for mode in rigging.JOINT_MODES:
+            combo.addItem(JOINT_MODE_LABELS[mode], mode)
+        j = doc.runtime[asset].joints[index]
+        combo.setCurrentIndex(rigging.JOINT_MODES.index("dynamic" if j.is_dynamic else
+                                                        "spring" if j.is_spring else "keyframed"))
+
+        def chosen(i: int) -> None:
+            mode = str(combo.itemData(i))
+            try:
+                command = rigging.set_joint_mode_command(doc, asset, joint, mode)
+            except rigging.RigError as exc:
+                window = self.window()
+                bar = getattr(window, "statusBar", None)
+                if callable(bar):
+                    bar().showMessage(str(exc), 5000)
+                QTimer.singleShot(0, self.rebuild)
+                return
+            # After the combo's signal returns: the change rebuilds this panel, combo included.
+            QTimer.singleShot(0, lambda: self.ctx.push(command))
+
+        combo.currentIndexChanged.connect(chosen)
+        self.editors["joint_mode"] = combo
+        return combo
+
+    def _spring_group(self, asset: str) -> QGroupBox:
+        """The character's spring constants: a preset and each value (document parameters
+        ``<asset>.spring.<name>``)."""
+        doc = self.ctx.doc
+        m2 = c2d()
+        assert m2 is not None
+        from qtanimator.core.spring_joint import SPRING_PRESETS, SpringParams
+
+        group = QGroupBox("Springs")
+        group.setObjectName("springProperties")
+        form = QFormLayout(group)
+        preset = QComboBox()
+        preset.setObjectName("springPreset")
+        preset.addItems([*SPRING_PRESETS, "custom"])
+
+        def current_preset() -> str:
+            params = m2.spring_params(doc, asset)
+            return next((name for name, p in SPRING_PRESETS.items() if p == params), "custom")
+
+        def apply_preset(name: str) -> None:
+            if name in SPRING_PRESETS and name != current_preset():
+                self.ctx.push(m2.set_spring_preset(doc, asset, name))
+
+        def refresh_preset() -> None:
+            preset.blockSignals(True)
+            preset.setCurrentText(current_preset())
+            preset.blockSignals(False)
+
+        preset.currentTextChanged.connect(apply_preset)
+        self._refreshers.append(refresh_preset)
+        self.editors["spring_preset"] = preset
+        form.addRow("Preset", preset)
+        defaults = SpringParams()
+        for f in fields(SpringParams):
+            path = f"{asset}.spring.{f.name}"
+            label, tip = SPRING_LABELS.get(f.name, (f.name, ""))
+
+            def check(value: Any, name: str = f.name) -> str | None:
+                try:
+                    replace(m2.spring_params(doc, asset), **{name: value})
+                except (TypeError, ValueError) as exc:
+                    return str(exc)
+                return None
+
+            editor = self._parameter_editor(form, label, path, getattr(m2.spring_params(doc, asset), f.name),
+                                            decimals=4, check=check)
+            editor.setToolTip(f"{tip} (default {getattr(defaults, f.name)!r})")
+
+            def refresh(editor: QWidget = editor, name: str = f.name) -> None:
+                if isinstance(editor, QDoubleSpinBox):
+                    editor.blockSignals(True)
+                    editor.setValue(float(getattr(m2.spring_params(doc, asset), name)))
+                    editor.blockSignals(False)
+
+            self._refreshers.append(refresh)
         return group
 
     def _pendulum_check(self, asset: str, name: str) -> Callable[[Any], str | None]:

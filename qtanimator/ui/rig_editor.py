@@ -18,10 +18,14 @@ joint's pose (the whole character's when the character — its root — is selec
 pastes it as keys at the current frame, Ctrl+Shift+V pastes it mirrored (left/right
 joints swap; see ``document.pose.mirrored_value``). Each is one undo step.
 
-Keys: Delete / Backspace delete the keys at the current frame; ``d`` toggles the debug
+Keys: Delete / Backspace delete the selected character's keys at the current frame
+(Shift+Delete / Shift+Backspace: every character's; in key-all mode always every
+character's, as keying is); ``d`` toggles the debug
 overlays (the character's path with velocity (blue) and acceleration (red) arrows at its
 keys, the IK source (red) / target (blue) dots and gradient arrows, and the HUD).
-Onion skin: ghosts of earlier / later frames, with counts, step and tints.
+Onion skin: ghosts of earlier / later frames, with counts, step and tints. The selected
+joint's limits (Properties) show as an orange wedge about its pivot that turns with its
+parent; a left-drag stops at a limit and follows the cursor back.
 
 Rig mode (the toolbar's *Rig Mode*, ``actionRigMode``; Spine's setup mode) shows each
 character in its setup (rest) pose with its pivots and bones: left-drag a pivot marker to
@@ -87,6 +91,9 @@ if TYPE_CHECKING:
 BACKGROUND = QColor(153, 153, 230)
 SCENE_LIMIT = 1.0e5
 ZOOM_PER_DEGREE = 1.0015  # per wheel unit (1/8 degree)
+#: The selected joint's limit wedge: radius on screen and colour (RGB).
+LIMIT_WEDGE_RADIUS_PX = 48.0
+LIMIT_WEDGE_COLOR = (255, 140, 0)
 
 
 def _c2d() -> Any:
@@ -552,6 +559,13 @@ class RigEditorView(QGraphicsView):
         dynamic.setEnabled(joint != 0)
         dynamic.triggered.connect(lambda on: self._rig_edit(
             lambda: rigging.set_dynamic_command(doc, asset, name, bool(on))))
+        spring = menu.addAction("Spring Joint")
+        spring.setObjectName("actionMarkSpring")
+        spring.setToolTip("the joint follows its keys through a damped spring (secondary motion)")
+        spring.setCheckable(True)
+        spring.setChecked(bool(character.joints[joint].is_spring))
+        spring.triggered.connect(lambda on: self._rig_edit(
+            lambda: rigging.set_joint_mode_command(doc, asset, name, "spring" if on else "keyframed")))
         remove = menu.addAction("Remove Joint")
         remove.setObjectName("actionRemoveJoint")
         remove.setEnabled(joint != 0)
@@ -580,7 +594,7 @@ class RigEditorView(QGraphicsView):
 
     def _draw_rig(self, painter: QPainter) -> None:
         """Rig mode: bones from each pivot to its children's, and the pivot markers
-        (white: dynamic; the selected joint's ringed)."""
+        (white: dynamic; blue: spring; the selected joint's ringed)."""
         poses = self.poses()
         radius = 5.0 * self._pixel_size()
         for aid in self.character_ids():
@@ -598,7 +612,8 @@ class RigEditorView(QGraphicsView):
                 c = pose.pivots[k]
                 ring = QColor(255, 200, 0) if k == selected else QColor(20, 20, 20)
                 painter.setPen(self._cosmetic(ring, 3.0 if k == selected else 1.5))
-                painter.setBrush(QBrush(QColor(255, 255, 255) if j.is_dynamic else QColor(220, 40, 40)))
+                painter.setBrush(QBrush(QColor(255, 255, 255) if j.is_dynamic else
+                                        QColor(60, 170, 255) if j.is_spring else QColor(220, 40, 40)))
                 painter.drawEllipse(QPointF(c[0], c[1]), radius, radius)
             painter.setBrush(Qt.BrushStyle.NoBrush)
 
@@ -692,7 +707,7 @@ class RigEditorView(QGraphicsView):
             event.accept()
             return
         if key in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace):
-            self.delete_keys()
+            self.delete_keys(all_characters=bool(event.modifiers() & Qt.KeyboardModifier.ShiftModifier))
             event.accept()
             return
         if key == Qt.Key.Key_D and not event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier:
@@ -742,13 +757,24 @@ class RigEditorView(QGraphicsView):
         self.ctx.push(command)
         return True
 
-    def delete_keys(self) -> None:
-        """Delete / Backspace: remove the keys at the current frame from every character."""
+    def delete_keys(self, all_characters: bool = False) -> bool:
+        """Delete / Backspace: remove the selected character's keys at the current frame;
+        Shift+Delete (``all_characters``): every 2D character's. In key-all mode every
+        character's, as keying is. True when keys were deleted."""
         if self._drag is not None:
-            return
-        command: Command | None = _c2d().delete_keys_at(self.ctx.doc, None, self.ctx.time)
-        if command is not None:
-            self.ctx.push(command)
+            return False
+        c2d = _c2d()
+        asset = self.ctx.selection[0]
+        if not all_characters and asset not in c2d.character_assets(self.ctx.doc):
+            if not bool(self.ctx.doc.parameter(c2d.KEY_ALL_PARAMETER, False)):
+                self._say("Select a character to delete its keys at this frame (Shift+Delete: every character's).")
+                return False
+        command: Command | None = c2d.delete_keys_at(self.ctx.doc, None if all_characters else asset,
+                                                     self.ctx.time)
+        if command is None:
+            return False
+        self.ctx.push(command)
+        return True
 
     def set_debug(self, on: bool) -> None:
         self.debug = on
@@ -787,6 +813,7 @@ class RigEditorView(QGraphicsView):
             self._draw_unkeyed_note(painter)
         if self.rig_mode:
             self._draw_rig(painter)
+        self._draw_limits(painter)
         if not self.debug:
             return
         ids = self.character_ids()
@@ -795,6 +822,29 @@ class RigEditorView(QGraphicsView):
         self._draw_paths(painter, ids)
         self._draw_ik(painter)
         self._draw_hud(painter)
+
+    def _draw_limits(self, painter: QPainter) -> None:
+        """The selected joint's allowed range as a wedge about its pivot (from its direction
+        at the lower limit to the upper, turning with the parent); only when it has limits."""
+        asset = self.ctx.selection[0]
+        if not asset or asset not in self.ctx.doc.runtime:
+            return
+        joint = self.selected_joint_index(asset)
+        pose = self.poses().get(asset)
+        if joint is None or pose is None:
+            return
+        limit = _c2d().joint_limits(self.ctx.doc, asset)[joint]
+        if limit is None:
+            return
+        outline = ri.limit_wedge(self.ctx.doc.runtime[asset], pose, joint, limit,
+                                 LIMIT_WEDGE_RADIUS_PX * self._pixel_size())
+        path = QPainterPath()
+        path.addPolygon(QPolygonF([QPointF(float(x), float(y)) for x, y in outline]))
+        painter.save()
+        painter.setBrush(QColor(*LIMIT_WEDGE_COLOR, 50))
+        painter.setPen(self._cosmetic(QColor(*LIMIT_WEDGE_COLOR), 2.5))
+        painter.drawPath(path)
+        painter.restore()
 
     def _draw_unkeyed_note(self, painter: QPainter) -> None:
         """Auto-key off: say that the pose shown is not keyed yet."""
@@ -1051,7 +1101,7 @@ class RigEditor(QWidget):
 # ---------------------------------------------------------------------- openers
 def open_characters(window: MainWindow, path: Path) -> None:
     """Add the characters of an SVG file or folder (FormatError leaves the document as is)."""
-    command = _c2d().add_characters_command(window.doc, path)
+    command = _c2d().add_characters_command(window.doc, path, new_project_range=True)
     window.ctx.push(command)
     editor = getattr(window, "rig_editor", None)
     if editor is not None:
@@ -1074,9 +1124,14 @@ def install(window: MainWindow) -> None:
     window.view_menu.addAction(editor.debug_action)
     delete = QAction("Delete Keys at Current Frame", window)
     delete.setObjectName("actionDeleteFrameKeys")
-    delete.setToolTip("Delete / Backspace in the 2D editor")
+    delete.setToolTip("The selected character's keys at the current frame (Delete / Backspace in the 2D editor)")
     delete.triggered.connect(lambda _c=False: editor.view.delete_keys())
     window.edit_menu.addAction(delete)
+    delete_all = QAction("Delete Keys at Current Frame (All Characters)", window)
+    delete_all.setObjectName("actionDeleteFrameKeysAll")
+    delete_all.setToolTip("Every 2D character's keys at the current frame (Shift+Delete in the 2D editor)")
+    delete_all.triggered.connect(lambda _c=False: editor.view.delete_keys(all_characters=True))
+    window.edit_menu.addAction(delete_all)
     window.edit_menu.addSeparator()
     for action in editor.pose_actions.values():
         window.edit_menu.addAction(action)

@@ -61,19 +61,34 @@ def rotation_delta(pivot: Sequence[float], press: Sequence[float], cursor: Seque
     return math.atan2(ax * by - ay * bx, ax * bx + ay * by)
 
 
+def nearest_allowed_angle(angle: float, lo: float, hi: float) -> float:
+    """The angle within ``lo``…``hi`` that points nearest to ``angle``: ``angle`` itself,
+    else ``angle`` ± whole turns when that lies inside, else the limit the shorter way
+    round (a joint dragged past its limit stops at it and follows the cursor back)."""
+    if lo <= angle <= hi:
+        return angle
+    turn = 2.0 * math.pi
+    turns = range(math.ceil((lo - angle) / turn), math.floor((hi - angle) / turn) + 1)
+    if turns:
+        return min(max(angle + min(turns, key=abs) * turn, lo), hi)
+    to_lo = abs(math.remainder(angle - lo, turn))
+    to_hi = abs(math.remainder(angle - hi, turn))
+    return lo if to_lo < to_hi else hi
+
+
 # ------------------------------------------------------------------------ drags
 def pose_edit(doc: Document, values: dict[str, float], time: float, text: str, autokey: bool) -> Command:
     """What a drag does with new channel values: key them (auto-key on, key-all
     respected) or only show them as the pending, unkeyed pose (auto-key off)."""
     if autokey:
-        return c2d.key_values(doc, values, time, text)
-    return pose.PosePreview(doc, values, time, text)
+        return c2d.key_values(doc, values, time, text)  # clamps to the joint limits
+    return pose.PosePreview(doc, c2d.clamp_values(doc, values, time), time, text)
 
 
 def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time: float,
                 autokey: bool = True) -> Drag:
     """Left-drag on a joint: rotate it about its pivot following the cursor (from the pose
-    the editor shows)."""
+    the editor shows), within the joint's limits (:func:`nearest_allowed_angle`)."""
     shown = c2d.evaluate_pose(doc, asset, time, block=False)
     pivot = shown.pivots[joint].copy()
     start = float(np.asarray(c2d.joint_angles(doc, asset, time, block=False))[joint])
@@ -81,6 +96,9 @@ def rotate_drag(doc: Document, asset: str, joint: int, press: Sequence[float], t
     cursor = yield None
     while True:
         angle = start + rotation_delta(pivot, press, cursor)
+        limit = c2d.joint_limits(doc, asset)[joint]
+        if limit is not None:
+            angle = nearest_allowed_angle(angle, *limit)
         values = c2d.joint_value(doc, asset, joint, angle, time)
         cursor = yield pose_edit(doc, values, time, f"Rotate {name}", autokey)
 
@@ -117,6 +135,42 @@ def ik_source(doc: Document, asset: str, joint: int, press: Sequence[float], tim
     """The rest-pose point of ``joint`` under ``press`` (kept for the debug dot)."""
     pose = c2d.evaluate_pose(doc, asset, time, block=False)
     return np.asarray(pose.to_local(joint, np.asarray(press, dtype=np.float64)), dtype=np.float64)
+
+
+# ------------------------------------------------------------------ joint limits
+def rest_direction(character: Any, joint: int) -> FloatArray:
+    """The unit direction a joint points along in the rest pose: towards its first child's
+    pivot, else its centre of mass, else +x."""
+    j = character.joints[joint]
+    target = character.joints[j.children[0]].pivot if j.children else j.centroid
+    d = np.asarray(target, dtype=np.float64) - np.asarray(j.pivot, dtype=np.float64)
+    n = float(np.hypot(*d))
+    return np.array([1.0, 0.0]) if n < 1e-9 else d / n
+
+
+def limit_wedge(character: Any, pose: Any, joint: int, limit: tuple[float, float], radius: float,
+                segments_per_turn: int = 96) -> FloatArray:
+    """The outline (N, 2) of a joint's allowed range: from the pivot out to the joint's
+    direction at the lower limit, along the arc of ``radius`` to the upper limit, back to
+    the pivot. Directions are the rest direction turned by the parent's world angle plus
+    the limit, so the wedge turns with the parent. A range of a whole turn or more is a
+    circle (no radii)."""
+    lo, hi = limit
+    pivot = np.asarray(pose.pivots[joint], dtype=np.float64)
+    parent = character.joints[joint].parent
+    base = 0.0 if parent is None else float(pose.world_angles[parent])
+    ref = rest_direction(character, joint)
+    full = hi - lo >= 2.0 * math.pi
+    if full:
+        hi = lo + 2.0 * math.pi
+    n = max(2, math.ceil((hi - lo) / (2.0 * math.pi) * segments_per_turn)) + 1
+    theta = base + np.linspace(lo, hi, n)
+    c, s = np.cos(theta), np.sin(theta)
+    # R(θ)·ref with R(θ) = [[cos θ, sin θ], [−sin θ, cos θ]] (counter-clockwise on screen).
+    arc = pivot + radius * np.stack([c * ref[0] + s * ref[1], -s * ref[0] + c * ref[1]], axis=1)
+    if full:
+        return np.asarray(arc, dtype=np.float64)
+    return np.vstack([pivot, arc, pivot])
 
 
 # --------------------------------------------------------------- debug overlays

@@ -5,8 +5,8 @@ Auto-key (``autoKeyButton`` / ``actionAutoKey``, red while on, like Blender's re
 button): on, posing keys at once; off, a drag only poses and S keys (see
 :mod:`qtanimator.document.pose`). Per project, saved with it as view state.
 
-Keys follow the reference animator: Space play / pause, ←/→ step (wrapping), Shift+←/→
-±10 frames, Alt+←/→ previous / next key, Home or ↑ start, End or ↓ end, ``[`` / ``]``
+Keys follow the reference animator: Space play / pause, ←/→ step and Shift+←/→ ±10
+frames (both wrapping around the range), Alt+←/→ previous / next key, Home or ↑ start, End or ↓ end, ``[`` / ``]``
 shorten / lengthen the range by 100 frames (an undoable parameter change).
 """
 
@@ -535,10 +535,10 @@ def _make_actions(window: MainWindow, playback: Playback, control: TimelineContr
                                  sp.SP_MediaSeekBackward),
         "actionStepForward": action("actionStepForward", "Step Forward", lambda: control.step(1), ["Right"],
                                     sp.SP_MediaSeekForward),
-        "actionStepBack10": action("actionStepBack10", "Back 10 Frames", lambda: control.step(-10, wrap=False),
+        "actionStepBack10": action("actionStepBack10", "Back 10 Frames", lambda: control.step(-10),
                                    ["Shift+Left"]),
         "actionStepForward10": action("actionStepForward10", "Forward 10 Frames",
-                                      lambda: control.step(10, wrap=False), ["Shift+Right"]),
+                                      lambda: control.step(10), ["Shift+Right"]),
         "actionPreviousKey": action("actionPreviousKey", "Previous Key", control.previous_key, ["Alt+Left"]),
         "actionNextKey": action("actionNextKey", "Next Key", control.next_key, ["Alt+Right"]),
         "actionShorterRange": action("actionShorterRange", "Shorten Range by 100", lambda: control.change_length(

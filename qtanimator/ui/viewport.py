@@ -9,8 +9,10 @@ Mouse: left click picks a joint (``ctx.select``); left drag orbits (on a live cl
 the cloth, on a light's sphere it moves the light); middle drag or Shift+left pans; wheel or
 Ctrl+left zooms; right drag on a joint solves IK on its chain (one undo step, keyed at the
 current frame); right drag elsewhere zooms. Keys: F frames the selection (or everything),
-W/A/S/D/Q/E move a live cloth's pins, Z/C rotate them, P pauses the live cloth, R resets it,
-Escape cancels an IK or light drag.
+X shows the axes (the MIT viewer's ``a``), B the skeleton (its ``s``), W/A/S/D/Q/E move a live
+cloth's pins, Z/C rotate them, P pauses the live cloth, R resets it, Escape cancels an IK or
+light drag. View ▸ 3D Camera… shows the camera's distance, azimuth and inclination as fields
+(:mod:`qtanimator.ui.camera_fields`); the toolbar's *Shadow* draws the floor shadow.
 
 Cloth never runs on the UI thread: a :class:`~qtanimator.document.cloth_worker.ClothWorker`
 fills the document's cloth caches in the background (the view draws the newest frame there
@@ -169,6 +171,10 @@ class Viewport3D(QWidget):
     liveClothChanged = Signal(bool)
     #: The cloth cache worker moved on: a list of ClothProgress (at most ~10 per second).
     clothProgressChanged = Signal(object)
+    #: The camera's distance, azimuth, inclination or target changed (mouse, fields, framing).
+    cameraChanged = Signal()
+    #: What the view shows changed (:meth:`set_display`: skin, skeleton, axes, shadow).
+    displayChanged = Signal()
 
     #: How often the simulations are polled while they run (ms).
     POLL_MS = 16
@@ -222,6 +228,7 @@ class Viewport3D(QWidget):
         self._grid_pending = False  # a restored camera: size the grid at the first paint
         self._drag: dict[str, Any] | None = None
         self._press_pos = QPointF()
+        self._camera_seen: tuple[float, ...] = ()   # what cameraChanged last announced
         self._prepare_state = ""    # prepare_gl: "", "context", "resources", "picture", "done"
         self._defer_renderer = False
         ctx.frameChanged.connect(lambda _f: self.update())
@@ -418,6 +425,7 @@ class Viewport3D(QWidget):
             if bounds is not None:
                 self.options.grid_scale = grid_scale_for(*bounds)
             self._grid_pending = False
+        self._camera_moved()
         doc = self.ctx.doc
         self.options.light_gizmo_size = self.gizmo_size()
         renderer.render(self._items, self.camera, w, h, lights_of(doc), ambient_of(doc), self.options)
@@ -488,7 +496,50 @@ class Viewport3D(QWidget):
         self.camera = camera
         self._framed_once = True
         self._grid_pending = True
+        self._camera_moved()
         return True
+
+    def _camera_moved(self) -> None:
+        """Announce ``cameraChanged`` when the camera differs from what was last announced."""
+        c = self.camera
+        now = (float(c.distance), float(c.azimuth), float(c.inclination),
+               *(float(v) for v in np.asarray(c.target, dtype=float)))
+        if now != self._camera_seen:
+            self._camera_seen = now
+            self.cameraChanged.emit()
+
+    def set_camera(self, distance: float | None = None, azimuth: float | None = None,
+                   inclination: float | None = None) -> None:
+        """Place the orbit camera by numbers (the camera fields; CSE169's distance, azimuth and
+        inclination in degrees) about its target. View state, like a mouse orbit: no undo step."""
+        c = self.camera
+        if distance is not None and math.isfinite(distance):
+            c.distance = float(np.clip(distance, 1e-3, 1e5))
+        if azimuth is not None and math.isfinite(azimuth):
+            c.azimuth = float(azimuth) % 360.0
+        if inclination is not None and math.isfinite(inclination):
+            c.inclination = float(np.clip(inclination, -89.0, 89.0))
+        self._framed_once = True   # a camera placed by hand is kept (and saved), not framed over
+        self._camera_moved()
+        self.update()
+
+    # ------------------------------------------------------------ display
+    def set_display(self, **changes: Any) -> None:
+        """Change what the view shows (fields of :class:`ViewOptions`), tell the toolbar and
+        the View menu (``displayChanged``) and repaint."""
+        for name, value in changes.items():
+            if not hasattr(self.options, name):
+                raise AttributeError(f"ViewOptions has no {name!r}")
+            setattr(self.options, name, value)
+        self.displayChanged.emit()
+        self.update()
+
+    def toggle_skeleton(self) -> None:
+        """B (the MIT viewer's ``s``): show or hide the skeleton; hiding it shows the skin."""
+        if self.options.show_skeleton:
+            self.set_display(show_skeleton=False, show_skin=True)
+        else:
+            self.set_display(show_skeleton=True)
 
     def camera_state(self) -> dict[str, Any]:
         """The camera as plain JSON data (what ``view3d.camera`` holds)."""
@@ -512,6 +563,7 @@ class Viewport3D(QWidget):
         self.options.grid_scale = grid_scale_for(*bounds)
         self._framed_once = True
         self._grid_pending = False
+        self._camera_moved()
         self.update()
 
     def frame_all(self) -> None:
@@ -520,6 +572,7 @@ class Viewport3D(QWidget):
         if bounds is not None:
             self.camera.frame(*bounds)
             self.options.grid_scale = grid_scale_for(*bounds)
+        self._camera_moved()
         self.update()
 
     def frame_selection(self) -> None:
@@ -534,6 +587,7 @@ class Viewport3D(QWidget):
                 for item in chosen:
                     if isinstance(item, CharacterDraw) and item.selected is not None:
                         self.camera.target = item.world[item.selected, :3, 3].copy()
+        self._camera_moved()
         self.update()
 
     def ray_at(self, pos: QPointF) -> tuple[np.ndarray, np.ndarray]:
@@ -629,6 +683,7 @@ class Viewport3D(QWidget):
             self._drag_light(pos)
         elif mode == "ik":
             self._drag_ik(pos)
+        self._camera_moved()
         self.update()
 
     def mouseReleaseEvent(self, event: QMouseEvent) -> None:
@@ -649,6 +704,7 @@ class Viewport3D(QWidget):
     def wheelEvent(self, event: QWheelEvent) -> None:
         steps = event.angleDelta().y() / 120.0
         self.camera.zoom(0.88 ** steps)
+        self._camera_moved()
         self.update()
 
     # ---------------------------------------------------------- light drag
@@ -811,6 +867,12 @@ class Viewport3D(QWidget):
             self.paste_pose(mirrored=bool(mods & shift))
         elif key == Qt.Key.Key_F:
             self.frame_selection()
+        elif key == Qt.Key.Key_X and mods == Qt.KeyboardModifier.NoModifier:
+            # the MIT viewer's ``a`` (A moves the cloth pins here)
+            self.set_display(show_axes=not self.options.show_axes)
+        elif key == Qt.Key.Key_B and mods == Qt.KeyboardModifier.NoModifier:
+            # the MIT viewer's ``s`` (S sets a key here)
+            self.toggle_skeleton()
         elif key in PIN_KEYS or key in PIN_TURNS:
             if not self.live.enabled:
                 self.set_live_cloth(True)
@@ -1010,6 +1072,11 @@ class ViewportPanel(QWidget):
         self.grid.setObjectName("viewportGrid")
         self.grid.setChecked(True)
         self.grid.toggled.connect(self._on_grid)
+        self.shadow = QCheckBox("Shadow", self)
+        self.shadow.setObjectName("viewportShadow")
+        self.shadow.setToolTip("Shadow on the floor (y = 0) from the brighter light")
+        self.shadow.toggled.connect(lambda on: self.view.set_display(show_shadow=on))
+        self.view.displayChanged.connect(self._sync_display)
         self.chain = QSpinBox(self)
         self.chain.setObjectName("viewportIkChain")
         self.chain.setRange(1, 20)
@@ -1029,7 +1096,8 @@ class ViewportPanel(QWidget):
         self.status.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         self.status.setAlignment(Qt.AlignmentFlag.AlignRight | Qt.AlignmentFlag.AlignVCenter)
         self.view.frameRendered.connect(self._on_frame_rendered)
-        for w in (self.show_mode, self.shading, self.weights, self.wireframe, self.grid, self.chain, frame):
+        for w in (self.show_mode, self.shading, self.weights, self.wireframe, self.grid, self.shadow, self.chain,
+                  frame):
             bar.addWidget(w)
         bar.addWidget(self.status, 1)
         layout = QVBoxLayout(self)
@@ -1040,9 +1108,19 @@ class ViewportPanel(QWidget):
         layout.addWidget(self.controls)
 
     def _on_show(self, index: int) -> None:
-        self.view.options.show_skin = index in (0, 1)
-        self.view.options.show_skeleton = index in (0, 2)
-        self.view.update()
+        self.view.set_display(show_skin=index in (0, 1), show_skeleton=index in (0, 2))
+
+    def _sync_display(self) -> None:
+        """Show what the view shows (after B, the View menu or a field here)."""
+        o = self.view.options
+        index = 0 if o.show_skin and o.show_skeleton else (1 if o.show_skin else 2)
+        for widget, set_value in ((self.show_mode, lambda: self.show_mode.setCurrentIndex(index)),
+                                  (self.shadow, lambda: self.shadow.setChecked(o.show_shadow))):
+            blocked = widget.blockSignals(True)
+            try:
+                set_value()
+            finally:
+                widget.blockSignals(blocked)
 
     def _on_shading(self, index: int) -> None:
         self.view.options.faceted = (None, True, False)[index]
@@ -1139,6 +1217,45 @@ def install(window: Any) -> None:
     window.add_central(panel, "3D")
     frame = window._action("actionFrameSelection3d", "Frame Selection (3D)", panel.view.frame_selection)
     window.view_menu.addAction(frame)
+    _install_display_actions(window, panel.view)
+
+
+def _install_display_actions(window: Any, view: Viewport3D) -> None:
+    """View menu: the camera fields and the display toggles of the 3D view. The keys are the
+    view's own (X, B: see its keyPressEvent), shown in the menu as hints only, so that X and B
+    keep their meaning in the other editors."""
+    from PySide6.QtGui import QAction
+
+    from qtanimator.ui.camera_fields import show_camera_dialog
+
+    camera = window._action("actionCamera3d", "3D Camera…", lambda: show_camera_dialog(window, view))
+    camera.setStatusTip("Distance, azimuth and inclination of the 3D view's camera as fields")
+    toggles = (
+        ("actionShowAxes3d", "Show Axes (3D)\tX", "show_axes", lambda on: view.set_display(show_axes=on)),
+        ("actionShowSkeleton3d", "Show Skeleton (3D)\tB", "show_skeleton",
+         lambda on: view.set_display(show_skeleton=on) if on or view.options.show_skin
+         else view.set_display(show_skeleton=False, show_skin=True)),
+        ("actionFloorShadow3d", "Floor Shadow (3D)", "show_shadow", lambda on: view.set_display(show_shadow=on)),
+    )
+    actions: list[tuple[QAction, str]] = []
+    window.view_menu.addAction(camera)
+    for name, text, option, slot in toggles:
+        action = QAction(text, window)
+        action.setObjectName(name)
+        action.setCheckable(True)
+        action.setChecked(bool(getattr(view.options, option)))
+        action.triggered.connect(slot)
+        window.view_menu.addAction(action)
+        actions.append((action, option))
+
+    def sync() -> None:
+        for action, option in actions:
+            blocked = action.blockSignals(True)
+            action.setChecked(bool(getattr(view.options, option)))
+            action.blockSignals(blocked)
+
+    view.displayChanged.connect(sync)
+    window.action_camera3d = camera
 
 
 __all__ = ["ClipControls", "ClothDraw", "LiveCloths", "Viewport3D", "ViewportPanel", "grab_with_3d", "install"]

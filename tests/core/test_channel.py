@@ -94,7 +94,8 @@ def test_tangent_rules_resolve_as_specified():
     assert s_in[3] == s_out[3] == pytest.approx(-3.0)  # smooth at the end: one-sided
     fixed = Channel([Key.make(0.0, 0.0, 13.7, -0.22), Key(1.0, 1.0)])
     assert fixed.slopes()[0][0] == 13.7 and fixed.slopes()[1][0] == -0.22
-    assert fixed.evaluate(0.0, 1) == pytest.approx(-0.22)
+    assert fixed.evaluate(1e-9, 1) == pytest.approx(-0.22, abs=1e-6)  # the span leaves on the out slope
+    assert fixed.evaluate(0.0, 1) == 0.0  # the first key itself: constant extrapolation's (issue 18)
 
 
 def test_clamped_has_no_overshoot():

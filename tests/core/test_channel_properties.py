@@ -10,8 +10,9 @@ from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key
 
 SETTINGS = settings(max_examples=60, deadline=None)
 
-rules = st.one_of(st.sampled_from(["flat", "linear", "smooth", "clamped"]),
+rules = st.one_of(st.sampled_from(["flat", "linear", "smooth", "clamped", "centripetal", "chordal", "tcb"]),
                   st.floats(-20, 20, allow_nan=False))
+tcb = st.floats(-1, 1, allow_nan=False)
 modes = st.sampled_from(list(Extrapolation))
 interps = st.sampled_from(list(Interpolation))
 
@@ -23,7 +24,8 @@ def channels(draw: st.DrawFn, min_keys: int = 0) -> Channel:
     gaps = draw(st.lists(st.floats(0.01, 5.0), min_size=n, max_size=n))
     times = start + np.cumsum([0.0] + gaps[:-1]) if n else []
     keys = [Key.make(float(t), draw(st.floats(-100, 100, allow_nan=False)), draw(rules), draw(rules),
-                     interpolation=draw(interps)) for t in times]
+                     interpolation=draw(interps), tension=draw(tcb), continuity=draw(tcb), bias=draw(tcb))
+            for t in times]
     return Channel(keys, draw(modes), draw(modes))
 
 

@@ -49,6 +49,9 @@ def control_points(ch: Channel, i: int) -> tuple[list[float], list[float]]:
 def reference(ch: Channel, t: float) -> tuple[float, float, float]:
     """Value, dy/dt and d²y/dt² inside the keys (the span that starts at or before t)."""
     times = [k.time for k in ch.keys]
+    if t in (times[0], times[-1]) and ch.pre is ch.post is Extrapolation.CONSTANT:
+        # The end keys belong to the extrapolation: derivatives 0 (CMU handout, issue 18).
+        return ch.keys[times.index(t)].value, 0.0, 0.0
     i = int(min(max(np.searchsorted(times, t, side="right") - 1, 0), len(times) - 2))
     xs, ys = control_points(ch, i)
     # Coordinates relative to the key nearer to t (the control points reversed when that
@@ -183,16 +186,24 @@ def test_clamping_uses_scaled_weights_but_the_key_keeps_its_own():
     assert np.isfinite(ch.evaluate(np.linspace(0, 1, 1001), 2)).all()
 
 
-def test_the_last_key_carries_the_end_derivatives_of_a_weighted_last_span():
-    ch = weighted_channel("both", "constant", "linear")
-    t1 = ch.keys[-1].time
+def test_the_end_derivatives_of_a_weighted_last_span_reach_the_keys_that_repeat_it():
+    # The end keys' derivatives are the extrapolation's (issue 18): a cycle before the first
+    # key ends with the last span's end, a bounce after the last key leaves on it mirrored.
+    ch = weighted_channel("both", "cycle", "bounce")
+    t0, t1 = ch.keys[0].time, ch.keys[-1].time
     want = reference(ch, t1 - 1e-12)
-    assert ch.evaluate(t1) == ch.keys[-1].value
-    assert close(ch.evaluate(t1, 1), want[1], 1e-7)
+    assert ch.evaluate(t1) == ch.keys[-1].value and ch.evaluate(t0) == ch.keys[0].value
+    assert close(ch.evaluate(t0, 1), want[1], 1e-7)
+    assert close(ch.evaluate(t0, 2), want[2], 1e-6)
+    assert close(ch.evaluate(t1, 1), -want[1], 1e-7)
     assert close(ch.evaluate(t1, 2), want[2], 1e-6)
-    assert ch.evaluate(np.array([t1]), 2)[0] == ch.evaluate(t1, 2)
-    # Linear extrapolation leaves along the last key's out slope, as without weights.
-    assert ch.evaluate(t1 + 1.0) == pytest.approx(ch.keys[-1].value + ch.slopes()[1][-1])
+    for d in (1, 2):
+        assert ch.evaluate(np.array([t0, t1]), d).tolist() == [ch.evaluate(t0, d), ch.evaluate(t1, d)]
+    # Linear extrapolation leaves along the last key's out slope, as without weights, from
+    # the last key itself on.
+    lin = weighted_channel("both", "constant", "linear")
+    assert lin.evaluate(t1 + 1.0) == pytest.approx(lin.keys[-1].value + lin.slopes()[1][-1])
+    assert lin.evaluate(t1, 1) == lin.slopes()[1][-1] and lin.evaluate(t1, 2) == 0.0
 
 
 @pytest.mark.parametrize("pre,post", list(itertools.product(MODES, MODES)))
@@ -279,8 +290,11 @@ def _reference_channels():
 
 
 #: The digest of these channels' values and derivatives, scalar and array, computed by the
-#: channel code before weighted tangents existed (commit cde32d5).
-UNWEIGHTED_DIGEST = "e88620847840378022234258dc4a852ffca4576fb1eb404c8133ecd116ae97a7"
+#: channel code before weighted tangents existed (commit cde32d5; the full digest was
+#: e88620847840378022234258dc4a852ffca4576fb1eb404c8133ecd116ae97a7). Issue 18 gave the
+#: first and last key the extrapolation's derivatives, so those samples are left out: this
+#: digest is what that older code gives for every other sample.
+UNWEIGHTED_DIGEST = "b6659ddd07c7365d1f3ed456782e7c2247a31702a4f2d1de0e344608486766f6"
 
 
 def test_unweighted_channels_evaluate_bit_for_bit_as_before_weights():
@@ -288,9 +302,11 @@ def test_unweighted_channels_evaluate_bit_for_bit_as_before_weights():
     h = hashlib.sha256()
     for ch in _reference_channels():
         assert not ch.is_weighted
+        ends = [ch.keys[0].time, ch.keys[-1].time] if len(ch.keys) > 1 else []
         for d in (0, 1, 2):
-            h.update(np.asarray(ch.evaluate(times, d), dtype="<f8").tobytes())
-            h.update(np.array([ch.evaluate(float(t), d) for t in times], dtype="<f8").tobytes())
+            keep = ~np.isin(times, ends) if d else np.ones(times.size, dtype=bool)
+            h.update(np.asarray(ch.evaluate(times, d), dtype="<f8")[keep].tobytes())
+            h.update(np.array([ch.evaluate(float(t), d) for t in times], dtype="<f8")[keep].tobytes())
     assert h.hexdigest() == UNWEIGHTED_DIGEST
 
 

@@ -124,3 +124,40 @@ def test_pendulum_lengths(shared_data: Path) -> None:
     [clock] = load_characters(shared_data / "cmu-animator" / "scenes" / "clock.svg")
     lengths = [clock.joints[i].reference_mass_properties.length for i in (1, 2, 5)]  # type: ignore[union-attr]
     np.testing.assert_allclose(lengths, [203.023, 150.126, 296.629], atol=2e-3)
+
+
+def test_owl_feathers_weigh_by_their_geometry_not_their_groups_opacity(shared_data: Path) -> None:
+    """Issue 18 item 7. The wing feathers sit in ``<g opacity="0.85">``: opacity is a look, not
+    a mass, and the reference program ignores group styles, so the group changes nothing.
+    Only an element's own ``opacity`` scales its fill density (the starter's rule, which the
+    table's owl 1 = area × 0.8 shows). Every one of the 86 feathers is the same outline
+    (areas within 5e-5 of each other), so each weighs the table's feather / 0.8 times its own
+    opacity, to the table's precision; and exactly its shoelace area times its own opacity."""
+    import xml.etree.ElementTree as ET
+
+    from qtanimator.formats.svg_rig import load_characters
+
+    path = shared_data / "cmu-animator" / "scenes" / "owl.svg"
+    [owl] = load_characters(path)
+    table_mass, table_opacity = 2178.00656, 0.8  # the table's owl 1 and its polygon's own opacity
+    ns = "{http://www.w3.org/2000/svg}"
+    own: dict[tuple[float, float], tuple[float, float, str | None]] = {}
+    for g in ET.parse(path).iter(f"{ns}g"):
+        kids = list(g)
+        if len(kids) == 2 and kids[0].tag == f"{ns}polygon" and kids[1].tag == f"{ns}circle":
+            pts = np.array([float(v) for v in kids[0].get("points", "").replace(",", " ").split()]).reshape(-1, 2)
+            x, y = pts[:, 0], pts[:, 1]
+            area = abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)))) / 2.0
+            centre = (round(float(kids[1].get("cx", "0")), 3), round(float(kids[1].get("cy", "0")), 3))
+            own[centre] = (area, float(kids[0].get("opacity", "1")), g.get("opacity"))
+    feathers = [j for j in owl.joints if j.is_dynamic]
+    assert len(feathers) == 86
+    in_faded_groups = 0
+    for j in feathers:
+        area, opacity, group_opacity = own[(round(float(j.pivot[0]), 3), round(float(j.pivot[1]), 3))]
+        in_faded_groups += group_opacity == "0.85"
+        assert j.mass == pytest.approx(area * opacity, rel=1e-9), j.name
+        assert j.mass == pytest.approx(table_mass / table_opacity * opacity, rel=1e-4), j.name
+        assert j.reference_mass_properties is not None
+        assert j.reference_mass_properties.mass == pytest.approx(j.mass, rel=1e-12)
+    assert in_faded_groups == 76

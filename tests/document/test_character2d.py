@@ -53,6 +53,25 @@ def test_add_characters_is_undoable(shared_data: Path) -> None:
         add_characters_command(doc, shared_data / "cmu-animator" / "SOURCE.md")
 
 
+def test_a_new_project_of_svg_characters_spans_the_cmu_300_frames() -> None:
+    # Issue 18: opened as a new project (the GUI, qtanimator render), SVG characters get the
+    # CMU animator's 300 frames, in the same undo step as the import.
+    doc = Document()
+    stack = UndoStack(doc)
+    stack.push(add_characters_command(doc, PIP, new_project_range=True))
+    assert doc.frame_range == (0, 300) and len(stack.done) == 1
+    stack.push(add_characters_command(doc, CLOCK, new_project_range=True))  # added to a project
+    assert doc.frame_range == (0, 300) and len(stack.done) == 2
+    stack.undo()
+    stack.undo()
+    assert doc.frame_range == (0, 240) and not doc.assets
+    edited = Document()
+    edited.parameters["frame_end"] = 90
+    add_characters_command(edited, PIP, new_project_range=True).do(edited)
+    assert edited.frame_range == (0, 90)  # a range the user set is kept
+    assert make()[0].frame_range == (0, 240)  # scripts (scene generators) keep their own range
+
+
 def test_key_joint_and_move_character() -> None:
     doc, stack, aid = make()
     ch = character(doc, aid)

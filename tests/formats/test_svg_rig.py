@@ -183,3 +183,23 @@ def test_project_scenes_load() -> None:
     [pip] = load_characters(root / "demo" / "pip.svg")
     assert [j.name for j in pip.joints if j.is_dynamic] == ["earring", "lantern_chain", "lantern"]
     assert pip.warnings == [] and clock.warnings == []
+
+
+GROUP_OPACITY = b"""<svg xmlns="http://www.w3.org/2000/svg"><style>.faint { opacity: 0.25 }</style>
+  <g>
+    <g><rect x="0" y="0" width="10" height="10"/><circle cx="0" cy="0" r="1"/></g>
+    <g opacity="0.5"><rect x="0" y="0" width="10" height="10"/><circle cx="0" cy="0" r="1" fill="#fff"/></g>
+    <g opacity="0.5"><rect x="0" y="0" width="10" height="10" opacity="0.8"/><circle cx="0" cy="0" r="1"/></g>
+    <g opacity="0.5"><rect x="0" y="0" width="10" height="10" style="opacity:0.4"/><circle cx="0" cy="0" r="1"/></g>
+    <g><rect class="faint" x="0" y="0" width="10" height="10"/><circle cx="0" cy="0" r="1"/></g>
+  </g>
+</svg>"""
+
+
+def test_group_opacity_is_a_look_not_a_mass() -> None:
+    """Issue 18 item 7: a group's opacity changes how a shape looks, never its mass; the
+    element's own opacity (attribute, style or CSS class) scales its fill density, as the
+    reference program's starter rule does."""
+    ch = parse_character(GROUP_OPACITY, "faded")
+    assert [j.mass for j in ch.joints] == pytest.approx([100.0, 100.0, 80.0, 40.0, 25.0])
+    assert [j.shapes[0].opacity for j in ch.joints[:2]] == [1.0, 0.5]  # still drawn faded

@@ -250,3 +250,30 @@ def test_part_colours_cover_every_triangle():
                                                        MeshPart("a", 0, 0, 1, 2, color=red)])
     assert part_colors(ch, 10) == ((0, 1, SKIN_COLOR), (1, 2, display_color(red)), (3, 2, SKIN_COLOR),
                                    (5, 3, display_color(blue)), (8, 2, SKIN_COLOR))
+
+
+def test_the_floor_shadow_darkens_each_floor_pixel_once(qapp):
+    """A closed skin covers its shadow twice (front and back): the stencil lets every floor
+    pixel darken once, so the shadow has one even tone; headless (multisampled) too."""
+    from qtanimator.document.character3d import add_character3d_command
+    from qtanimator.paths import scenes_dir
+    from qtanimator.render.gl.renderer import SHADOW_COLOR
+    from qtanimator.render.render3d import render_frames_3d
+
+    doc = Document()
+    arm = scenes_dir() / "arm3d"
+    UndoStack(doc).push(add_character3d_command(doc, arm / "arm.skel", arm / "arm.skin", asset_id="arm"))
+    bg = (0.5, 0.5, 0.5, 1.0)
+    camera = OrbitCamera(azimuth=30.0, inclination=60.0, distance=7.0, target=np.array([0.0, 0.5, 0.0]))
+    off, on = (next(render_frames_3d(doc, [0.0], (240, 180), camera=camera,
+                                     options=ViewOptions(show_grid=False, show_lights=False, show_skeleton=False,
+                                                         background=bg, show_shadow=shadow)))
+               for shadow in (False, True))
+    background = (np.abs(off[..., :3].astype(int) - 128) <= 1).all(axis=2)
+    level = on[..., :3].astype(int)[background]
+    shaded = level.max(axis=1) < 120
+    assert shaded.sum() > 200
+    once = round(128 * (1 - SHADOW_COLOR[3]))
+    # every shadow pixel is at the single-darkening tone or lighter (anti-aliased edges), none darker
+    assert level[shaded].min() >= once - 2
+    assert np.mean(np.abs(level[shaded] - once).max(axis=1) <= 2) > 0.8

@@ -222,6 +222,38 @@ def test_moving_several_keys_keeps_rules_and_slopes(qtbot, editor):
     assert doc.channels["hero//y"] == old
 
 
+def test_catmull_rom_and_tcb_rules_in_the_menu_and_the_tcb_fields(qtbot, editor):
+    # Issue 18: centripetal, chordal and TCB tangents per key; T / C / B fields for a TCB key.
+    ed = editor
+    doc = ed.ctx.doc
+    fields = ed.fields
+    qtbot.mouseClick(ed.plot.viewport(), Qt.MouseButton.LeftButton, pos=key_pos(ed, "hero//y", 1))
+    assert all(fields.tcb[n].isHidden() for n in fields.tcb)  # a smooth key has none
+    for rule in ("centripetal", "chordal"):
+        ed.tangent_actions[("both", rule)].trigger()
+        key = doc.channels["hero//y"].keys[1]
+        assert (key.in_tangent, key.out_tangent) == (Tangent(rule), Tangent(rule))
+    assert ed.tangent_actions[("both", "tcb")].text().startswith("TCB")
+    ed.tangent_actions[("out", "tcb")].trigger()
+    key = doc.channels["hero//y"].keys[1]
+    assert (key.in_tangent, key.out_tangent) == (Tangent.CHORDAL, Tangent.TCB)
+    ed.show_current_rules()
+    assert ed.tangent_actions[("out", "tcb")].isChecked() and ed.tangent_actions[("in", "chordal")].isChecked()
+    assert not any(fields.tcb[n].isHidden() for n in fields.tcb)
+    steps = ed.ctx.undo_stack.count()
+    fields.tcb["tension"].setValue(0.5)
+    fields.tcb["bias"].setValue(-0.25)
+    key = doc.channels["hero//y"].keys[1]
+    assert (key.tension, key.continuity, key.bias) == (0.5, 0.0, -0.25)
+    assert ed.ctx.undo_stack.count() == steps + 2  # one step per edit
+    s_in, s_out = doc.channels["hero//y"].slopes()
+    assert fields.out_slope.value() == pytest.approx(float(s_out[1]), abs=1e-5)
+    ed.ctx.undo_stack.undo()
+    assert doc.channels["hero//y"].keys[1].bias == 0.0 and fields.tcb["bias"].value() == 0.0
+    ed.tangent_actions[("both", "smooth")].trigger()
+    assert all(fields.tcb[n].isHidden() for n in fields.tcb)
+
+
 def test_tangent_and_extrapolation_menus(qtbot, editor):
     ed = editor
     doc = ed.ctx.doc

@@ -189,6 +189,43 @@ def test_delete_removes_the_keys_at_the_current_frame(qtbot, arm):
     assert len(doc.channels[f"{asset}//x"].keys) == 2
 
 
+def test_delete_takes_the_selected_characters_keys_and_shift_delete_everyones(qtbot, arm, shared_data):
+    # Issue 18: Delete acts on the selected character, Shift+Delete on every character.
+    window, view, first = arm
+    doc, ctx = window.doc, window.ctx
+    assert window.open_path(shared_data / "cmu-animator" / "scenes" / "arm.svg")
+    second = [a for a in doc.assets if a != first][0]
+    for asset in (first, second):
+        for frame in (0, 30):
+            ctx.push(c2d.key_joint(doc, asset, 1, 0.1 * (frame + 1), frame / doc.fps))
+    ctx.set_frame(30)
+
+    def frames(asset):
+        ch = doc.channels[c2d.angle_channel_id(asset, doc.runtime[asset].joints[1].name)]
+        return [round(k.time * doc.fps) for k in ch.keys]
+
+    view.setFocus()
+    ctx.select("", "")
+    qtbot.keyClick(view, Qt.Key.Key_Delete)  # nothing selected: nothing deleted
+    assert frames(first) == frames(second) == [0, 30]
+    ctx.select(second, doc.runtime[second].joints[1].name)
+    qtbot.keyClick(view, Qt.Key.Key_Delete)
+    assert frames(first) == [0, 30] and frames(second) == [0]
+    ctx.undo_stack.undo()
+    assert frames(second) == [0, 30]
+    qtbot.keyClick(view, Qt.Key.Key_Backspace, Qt.KeyboardModifier.ShiftModifier)
+    assert frames(first) == frames(second) == [0]
+    ctx.undo_stack.undo()
+    ctx.select("", "")
+    window.findChild(type(window.action_save), "actionDeleteFrameKeysAll").trigger()
+    assert frames(first) == frames(second) == [0]
+
+
+def test_a_new_project_of_svg_characters_gets_300_frames(qtbot, arm):
+    window, _view, _asset = arm
+    assert window.doc.frame_range == (0, 300)  # the CMU animator's timeline
+
+
 def test_d_toggles_debug_overlays_and_hud(qtbot, arm):
     window, view, asset = arm
     assert not view.debug

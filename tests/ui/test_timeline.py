@@ -49,6 +49,11 @@ def test_keys_step_and_jump(make_window, qtbot):
     assert ctx.frame == 0
     qtbot.keyClick(timeline, Qt.Key.Key_Down)
     assert ctx.frame == 240
+    # Shift ±10 wraps around the range like the single steps (the CMU animator's keys).
+    qtbot.keyClick(timeline, Qt.Key.Key_Right, Qt.KeyboardModifier.ShiftModifier)
+    assert ctx.frame == 9  # 240 + 10 over the 241 frames 0…240
+    qtbot.keyClick(timeline, Qt.Key.Key_Left, Qt.KeyboardModifier.ShiftModifier)
+    assert ctx.frame == 240
     qtbot.keyClick(timeline, Qt.Key.Key_Home)
     assert ctx.frame == 0
 

@@ -34,6 +34,12 @@ SELECTED_COLOR = (1.0, 0.62, 0.1, 1.0)
 CLOTH_COLOR = (0.75, 0.2, 0.22, 1.0)
 WIRE_COLOR = (0.05, 0.05, 0.08, 0.35)   # blended over the shaded surface
 BACKGROUND = (0.17, 0.18, 0.2, 1.0)
+#: The floor shadow: black at this opacity, blended once per pixel over the floor.
+SHADOW_COLOR = (0.0, 0.0, 0.0, 0.5)
+#: The plane shadows fall on (the grid's plane).
+FLOOR_HEIGHT = 0.0
+#: Colours of the x, y and z axes (the MIT viewer's red, green, blue).
+AXIS_COLORS = ((0.92, 0.22, 0.2, 1.0), (0.3, 0.85, 0.3, 1.0), (0.25, 0.45, 1.0, 1.0))
 
 #: weight_mode values (the shader's u_weight_mode): no pseudo-colour, or every joint's colour.
 WEIGHTS_OFF, WEIGHTS_ALL = -2, -1
@@ -59,6 +65,10 @@ class ViewOptions:
     light_gizmo_size: float = 0.08
     #: the ground grid spans ±5·scale with lines every 0.5·scale (see :func:`grid_scale_for`)
     grid_scale: float = 1.0
+    #: world axes at the origin and small x / y / z axes at every joint (the MIT viewer's ``a``)
+    show_axes: bool = False
+    #: a planar shadow of the characters and cloths on the floor (y = 0) from the key light
+    show_shadow: bool = False
 
 
 def grid_scale_for(bmin: np.ndarray, bmax: np.ndarray) -> float:
@@ -142,6 +152,48 @@ def bone_matrices(world: np.ndarray, parents: Sequence[int], radius: float) -> n
         m[:3, 0], m[:3, 1], m[:3, 2], m[:3, 3] = x * radius, y * radius, z * length, a
         out.append(m)
     return np.array(out).reshape(-1, 4, 4)
+
+
+def axes_matrices(frames: np.ndarray, length: float, radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Model matrices mapping the unit cylinder onto the x, y and z axes of each frame (K, 4, 4)
+    from its origin, ``length`` long (a frame's scale is ignored), and their colours:
+    (3K, 4, 4), (3K, 4)."""
+    frames = np.asarray(frames, dtype=float).reshape(-1, 4, 4)
+    k = len(frames)
+    out = np.zeros((k, 3, 4, 4))
+    out[:, :, 3, 3] = 1.0
+    for axis in range(3):
+        z = frames[:, :3, axis]
+        norm = np.linalg.norm(z, axis=1, keepdims=True)
+        z = np.where(norm > 1e-12, z / np.maximum(norm, 1e-12), np.eye(3)[axis])
+        helper = np.where(np.abs(z[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
+        x = np.cross(helper, z)
+        x /= np.linalg.norm(x, axis=1, keepdims=True)
+        y = np.cross(z, x)
+        m = out[:, axis]
+        m[:, :3, 0], m[:, :3, 1], m[:, :3, 2] = x * radius, y * radius, z * length
+        m[:, :3, 3] = frames[:, :3, 3]
+    colors = np.tile(np.asarray(AXIS_COLORS), (k, 1))
+    return out.reshape(-1, 4, 4), colors
+
+
+def shadow_matrix(light: np.ndarray, floor: float = FLOOR_HEIGHT) -> np.ndarray:
+    """The planar projection from a point light onto the plane y = ``floor`` (the OpenGL Red
+    Book's shadow matrix): ``M = (P·L) I − L Pᵀ`` with the plane P = (0, 1, 0, −floor) and the
+    light L = (x, y, z, 1). A point p lands where the ray from the light through p meets the
+    floor (homogeneous: divide by w = L_y − p_y, so points above the light have none)."""
+    plane = np.array([0.0, 1.0, 0.0, -float(floor)])
+    lh = np.append(np.asarray(light, dtype=float).reshape(3), 1.0)
+    return float(plane @ lh) * np.eye(4) - np.outer(lh, plane)
+
+
+def key_light(lights: Sequence[Light]) -> Light | None:
+    """The light that casts the floor shadow: the brightest (light 1 on a tie), if any."""
+    best: Light | None = None
+    for light in lights:
+        if best is None or float(np.sum(light.radiance)) > float(np.sum(best.radiance)) + 1e-12:
+            best = light
+    return best
 
 
 def box_matrices(world: np.ndarray, boxmin: np.ndarray, boxmax: np.ndarray) -> np.ndarray:
@@ -232,6 +284,8 @@ class SceneRenderer:
 
         if opts.show_grid:
             self._draw_grid(opts.grid_scale)
+        if opts.show_axes:
+            self._draw_world_axes(opts.grid_scale)
         live_skins, live_cloths = set(), set()
         xray: list[CharacterDraw] = []
         for item in items:
@@ -252,10 +306,16 @@ class SceneRenderer:
             elif isinstance(item, ClothDraw):
                 live_cloths.add(item.asset_id)
                 self._draw_cloth(item, opts)
-        if xray:
+        if opts.show_shadow:
+            self._draw_shadows(items, lights, opts)
+        characters = [i for i in items if isinstance(i, CharacterDraw)] if opts.show_axes else []
+        if xray or characters:
+            # the skeleton over a skin and the joint axes are drawn in front of everything
             GL.glClear(GL.GL_DEPTH_BUFFER_BIT)
             for item in xray:
                 self._draw_skeleton(item, thin=True)
+            for item in characters:
+                self._draw_joint_axes(item)
         if opts.show_lights:
             self._draw_light_gizmos(lights, opts.light_gizmo_size)
         self._forget(live_skins, live_cloths)
@@ -288,6 +348,104 @@ class SceneRenderer:
         self._grid.draw()
         self._count(self._grid)
         self._reset_state()
+
+    def _draw_world_axes(self, scale: float) -> None:
+        """The MIT viewer's coordinate axes: x, y, z from the origin, two grid cells long."""
+        assert self._cylinder is not None
+        p = self.program
+        assert p is not None
+        models, colors = axes_matrices(np.eye(4)[None], scale, 0.012 * scale)
+        p.set("u_lit", 0)
+        self._instanced(self._cylinder, models, colors)
+        p.set("u_lit", 1)
+
+    def _draw_joint_axes(self, item: CharacterDraw) -> None:
+        """Small x / y / z axes at every joint, in the joint's frame."""
+        assert self._cylinder is not None
+        p = self.program
+        assert p is not None
+        r = item.joint_radius
+        models, colors = axes_matrices(item.world, 4.0 * r, 0.22 * r)
+        p.set("u_lit", 0)
+        self._instanced(self._cylinder, models, colors)
+        p.set("u_lit", 1)
+
+    def _draw_shadows(self, items: Sequence[SceneItem], lights: Sequence[Light], opts: ViewOptions) -> None:
+        """Every character and cloth once more, flattened onto the floor from the key light:
+        the skin skinned on the GPU as usual with the projection as its model matrix (no CPU
+        work per vertex), or the skeleton where no skin is drawn. The stencil buffer lets each
+        floor pixel darken once however many surfaces project onto it."""
+        light = key_light(lights)
+        if light is None or float(light.position[1]) <= FLOOR_HEIGHT + 1e-6:
+            return   # a light on or below the floor casts nothing onto it
+        p = self.program
+        assert p is not None
+        top = float(light.position[1])
+        casters: list[CharacterDraw | ClothDraw] = []
+        for item in items:
+            if isinstance(item, CharacterDraw) and len(item.world):
+                if float(np.max(item.world[:, 1, 3])) < top:
+                    casters.append(item)
+            elif isinstance(item, ClothDraw) and len(item.positions):
+                if float(np.max(item.positions[:, 1])) < top:
+                    casters.append(item)
+        if not casters:
+            return
+        GL.glEnable(GL.GL_BLEND)
+        # "over" for alpha too: an opaque floor stays opaque (read-backs un-premultiply), and
+        # over a transparent background the shadow is half-transparent black
+        GL.glBlendFuncSeparate(GL.GL_SRC_ALPHA, GL.GL_ONE_MINUS_SRC_ALPHA, GL.GL_ONE, GL.GL_ONE_MINUS_SRC_ALPHA)
+        GL.glDepthMask(GL.GL_FALSE)
+        GL.glDepthFunc(GL.GL_LEQUAL)
+        GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
+        GL.glPolygonOffset(-1.0, -1.0)
+        GL.glClearStencil(0)
+        GL.glClear(GL.GL_STENCIL_BUFFER_BIT)
+        GL.glEnable(GL.GL_STENCIL_TEST)
+        GL.glStencilFunc(GL.GL_EQUAL, 0, 0xFF)
+        GL.glStencilOp(GL.GL_KEEP, GL.GL_KEEP, GL.GL_INCR)
+        color = np.asarray(SHADOW_COLOR, dtype=float)
+        model = shadow_matrix(light.position)
+        try:
+            for item in casters:
+                p.set("u_lit", 0)
+                p.set("u_model", model)
+                p.set("u_color", color)
+                if isinstance(item, ClothDraw):
+                    cached = self._cloths.get(item.asset_id)
+                    if cached is not None:
+                        cached[2].draw()
+                        self._count(cached[2])
+                elif item.skin is not None and opts.show_skin:
+                    mesh = self.skinned_mesh(item.skin, item.asset_id)
+                    mesh.bind_textures()   # this frame's joint matrices: uploaded for the skin
+                    p.set("u_skinning", 1)
+                    mesh.draw()
+                    self._count(mesh)
+                else:
+                    self._draw_skeleton_shadow(item, model, color)
+                self._reset_state()
+        finally:
+            GL.glDisable(GL.GL_STENCIL_TEST)
+            GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
+            GL.glDepthFunc(GL.GL_LESS)
+            GL.glDepthMask(GL.GL_TRUE)
+            GL.glDisable(GL.GL_BLEND)
+
+    def _draw_skeleton_shadow(self, item: CharacterDraw, model: np.ndarray, color: np.ndarray) -> None:
+        """The skeleton's boxes (or spheres and bones) as they are drawn, flattened by ``model``."""
+        assert self._cube is not None and self._sphere is not None and self._cylinder is not None
+        n = len(item.world)
+        if item.boxmin is not None and item.boxmax is not None:
+            self._instanced(self._cube, box_matrices(item.world, item.boxmin, item.boxmax), np.tile(color, (n, 1)))
+            return
+        r = item.joint_radius
+        spheres = np.tile(np.eye(4), (n, 1, 1))
+        spheres[:, :3, :3] *= r
+        spheres[:, :3, 3] = item.world[:, :3, 3]
+        self._instanced(self._sphere, spheres, np.tile(color, (n, 1)))
+        bones = bone_matrices(item.world, item.parents, r * 0.8)
+        self._instanced(self._cylinder, bones, np.tile(color, (len(bones), 1)))
 
     def _draw_plane(self, item: PlaneDraw) -> None:
         p = self.program

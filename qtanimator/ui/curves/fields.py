@@ -3,11 +3,13 @@
 Values are shown in the channel's display unit (degrees for rotations, as the plot shows
 them) and slopes in that unit per second. Editing a slope makes that side fixed; unless
 the key is broken, the other side follows, as when dragging a handle. Each edit is one
-command. With no key selected the fields are empty and disabled.
+command. With no key selected the fields are empty and disabled. When the active key has a
+TCB (Kochanek–Bartels) side, its Tension, Continuity and Bias fields (−1…1) show too.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 from PySide6.QtWidgets import QHBoxLayout, QLabel, QWidget
@@ -39,20 +41,39 @@ class KeyFields(QWidget):
         self.value = _spin("curveKeyValue", 5, "Value of the active key")
         self.in_slope = _spin("curveKeyInSlope", 5, "In slope (value per second); sets a fixed slope")
         self.out_slope = _spin("curveKeyOutSlope", 5, "Out slope (value per second); sets a fixed slope")
+        # Kochanek–Bartels parameters of a key with a TCB side (hidden otherwise).
+        self.tcb: dict[str, CheckedDoubleSpinBox] = {}
+        self._tcb_labels: list[QLabel] = []
+        for name, tip in (("tension", "Tension: +1 tightens the curve at the key, −1 rounds it"),
+                          ("continuity", "Continuity: 0 keeps the slope continuous; −1 box corners, +1 inverted "
+                                         "corners"),
+                          ("bias", "Bias: +1 overshoots after the key (follow-through), −1 before it")):
+            box = _spin(f"curveKey{name.capitalize()}", 3, tip)
+            box.setRange(-1.0, 1.0)
+            box.setSingleStep(0.1)
+            box.setMinimumWidth(70)
+            self.tcb[name] = box
         self.label = QLabel("No key selected")
         self.label.setObjectName("curveKeyLabel")
         layout = QHBoxLayout(self)
         layout.setContentsMargins(4, 2, 4, 2)
         layout.addWidget(self.label, 1)
         for text, box in (("Frame", self.frame), ("Value", self.value), ("In", self.in_slope),
-                          ("Out", self.out_slope)):
-            layout.addWidget(QLabel(text))
+                          ("Out", self.out_slope), ("T", self.tcb["tension"]), ("C", self.tcb["continuity"]),
+                          ("B", self.tcb["bias"])):
+            label = QLabel(text)
+            layout.addWidget(label)
             layout.addWidget(box)
+            if len(text) == 1:
+                label.setToolTip(box.toolTip())
+                self._tcb_labels.append(label)
         self._loading = False
         self.frame.valueChanged.connect(self._frame_edited)
         self.value.valueChanged.connect(self._value_edited)
         self.in_slope.valueChanged.connect(lambda v: self._slope_edited("in", v))
         self.out_slope.valueChanged.connect(lambda v: self._slope_edited("out", v))
+        for name, box in self.tcb.items():
+            box.valueChanged.connect(lambda v, n=name: self._tcb_edited(n, v))
         view.keySelectionChanged.connect(self.load)
         view.ctx.documentChanged.connect(lambda _e: self.load())
         self.load()
@@ -77,12 +98,14 @@ class KeyFields(QWidget):
         for box in boxes:
             box.setEnabled(found is not None)
         if found is None:
+            self._show_tcb(None)
             self.label.setText("No key selected")
             for box in boxes:
                 box.clear()  # empty: nothing to show (the value is kept, unused)
             return
         cid, i, ch = found
         key = ch.keys[i]
+        self._show_tcb(key if Tangent.TCB in (key.in_tangent, key.out_tangent) else None)
         s_in, s_out = ch.slopes()
         count = sum(len(s) for s in self.view.selection.values())
         self.label.setText(f"{cid} [{i}]" + (f" (+{count - 1})" if count > 1 else ""))
@@ -98,6 +121,33 @@ class KeyFields(QWidget):
             self.out_slope.setValue(float(s_out[i]) * unit)
         finally:
             self._loading = False
+
+    def _show_tcb(self, key: Any) -> None:
+        """The Tension / Continuity / Bias fields: shown with ``key``'s values, or hidden."""
+        shown = key is not None
+        for label in self._tcb_labels:
+            label.setVisible(shown)
+        was = self._loading
+        self._loading = True
+        try:
+            for name, box in self.tcb.items():
+                box.setVisible(shown)
+                box.setEnabled(shown)
+                if shown:
+                    box.setValue(float(getattr(key, name)))
+        finally:
+            self._loading = was
+
+    def _tcb_edited(self, name: str, value: float) -> None:
+        found = self._active()
+        if self._loading or found is None:
+            return
+        cid, i, ch = found
+        key = ch.keys[i]
+        if round(float(getattr(key, name)), 3) == round(value, 3):
+            return
+        self.view.push(EditKey(self.view.doc, cid, i, replace(key, **{name: float(value)}),
+                               text=f"Key {name.capitalize()}"))
 
     def _frame_edited(self, frame: float) -> None:
         found = self._active()
