@@ -8,7 +8,9 @@ The demo project combines the bundled scenes:
   the linear-key walk of ``scenes/robot/robot.qtanim``, moved to the right of the clock;
 * 3D (the viewport): the skinned arm of ``scenes/arm3d`` with its ``arm_wave.anim`` loop, and
   a small flag (a mass-spring cloth pinned along its left edge) in a gusty wind, to the
-  arm's left so it never hides it.
+  arm's left so it never hides it; and Walker (``scenes/walker``, made by
+  ``scenes/tools/make_walker.py``) walking across the front in a cape pinned to its chest
+  (a cloth whose ``attach`` names the ``chest`` joint; it collides with capsules around the bones).
 
 Saved through ``save_document`` so the file is exactly what the program writes; the asset
 sources are stored relative to ``scenes/demo/``.
@@ -26,15 +28,20 @@ from qtanimator.document import Document, SetChannels, SetKeys, SetParameter, op
 from qtanimator.document.character2d import add_characters_command, angle_channel_id, position_channel_ids
 from qtanimator.document.character3d import add_character3d_command
 from qtanimator.document.cloth import add_cloth_command
+from qtanimator.document.cloth_attach import ATTACH
+from qtanimator.document.commands import SetAssetProperty
 
 HERE = Path(__file__).resolve().parent
 FPS = 60.0
 ROBOT_SHIFT = 1130.0  # Robo's rest hip is at x = 300 in robot.svg; walk it right of the clock
 FLAG_ROWS, FLAG_COLS = 16, 24
 FLAG_WIDTH = 1.5
-#: The saved 3D camera: from the front, a little above, the flag on the left, the arm right.
-VIEW3D_CAMERA = {"azimuth": 15.0, "inclination": 10.0, "distance": 4.3,
-                 "target": [-0.95, 1.95, 0.0], "fov_y": 45.0}
+#: The saved 3D camera: from the front, a little above, the flag on the left, the arm right,
+#: Walker and its cape in front.
+VIEW3D_CAMERA = {"azimuth": 15.0, "inclination": 12.0, "distance": 6.8,
+                 "target": [-0.2, 1.5, 0.4], "fov_y": 45.0}
+CAPE_ROWS, CAPE_COLS = 14, 10
+CAPE_WIDTH, CAPE_HEIGHT = 0.46, 0.85
 
 
 def flag_params() -> ClothParams:
@@ -51,6 +58,19 @@ def flag_params() -> ClothParams:
         ground_enabled=True, ground_height=0.0,
         pin_mode="custom", custom_pins=pins_from_cells(FLAG_COLS, [(r, 0) for r in range(FLAG_ROWS)]),
         substeps=32, origin=(-2.9 + FLAG_WIDTH / 2, 2.7, -0.3), orientation=(0.0, 0.0, 0.0),
+    )
+
+
+def cape_params() -> ClothParams:
+    """A 0.46 m × 0.85 m cape (14 × 10 particles, 0.3 kg) whose top edge is pinned across
+    Walker's back, 0.19 m behind its chest joint at frame 0 (Walker faces +x from x = −0.6,
+    z = 1.2); implicit integrator, automatic steps."""
+    return ClothParams(
+        rows=CAPE_ROWS, cols=CAPE_COLS, width=CAPE_WIDTH, height=CAPE_HEIGHT, total_mass=0.3,
+        structural_stiffness=300.0, shear_stiffness=120.0, bend_stiffness=6.0,
+        structural_damping=0.2, shear_damping=0.1, bend_damping=0.02,
+        ground_enabled=True, ground_height=0.0, collision_margin=0.01,
+        pin_mode="top_edge", origin=(-0.6 - 0.19, 1.5, 1.2), orientation=(0.0, math.pi / 2, 0.0),
     )
 
 
@@ -96,6 +116,11 @@ def build() -> Document:
     arm = HERE / "arm3d"
     add_character3d_command(doc, arm / "arm.skel", arm / "arm.skin", arm / "arm_wave.anim", asset_id="arm").do(doc)
     add_cloth_command(doc, flag_params(), asset_id="flag").do(doc)
+    walker = HERE / "walker"
+    add_character3d_command(doc, walker / "walker.skel", walker / "walker.skin", walker / "walker_walk.anim",
+                            asset_id="walker").do(doc)
+    add_cloth_command(doc, cape_params(), asset_id="cape").do(doc)
+    SetAssetProperty(doc, "cape", ATTACH, {"asset": "walker", "joint": "chest"}, text="Attach the cape").do(doc)
     # The 3D view opens on the flag and the arm (view state, as the program saves it).
     doc.set_view_state("view3d.camera", dict(VIEW3D_CAMERA))
     return doc

@@ -19,6 +19,7 @@ Shots (``docs/images/NAME.png``):
 * ``joint_tree`` — the Joints dock with the 3D arm's elbow selected and its DOF sliders;
 * ``pendulum_properties`` — the Properties dock for Pip's pendulum lantern;
 * ``cloth_panel`` — the Cloth dock with the flag;
+* ``cape`` — the 3D tab on Walker walking in its cape (a cloth attached to its chest);
 * ``export_dialog`` — File ▸ Export Animation…;
 * ``gltf_clips`` — a glTF character with three clips (built here with ``tests/gltf_gen.py``'s
   builder: no such file is in the shared samples), its clip picked in Properties and the
@@ -40,8 +41,8 @@ REPO = Path(__file__).resolve().parents[1]
 OUT = REPO / "docs" / "images"
 MAX_WIDTH = 1400
 WINDOW_SIZE = (1400, 900)
-SHOTS = ("main_window", "curve_editor", "viewport_3d", "viewport_shadow", "joint_tree", "pendulum_properties",
-         "cloth_panel", "export_dialog", "gltf_clips")
+SHOTS = ("main_window", "curve_editor", "viewport_3d", "viewport_shadow", "joint_tree", "outliner",
+         "pendulum_properties", "cloth_panel", "cape", "export_dialog", "gltf_clips")
 
 
 # ------------------------------------------------------------------ display
@@ -264,6 +265,22 @@ class Shooter:
         self.grab_window("viewport_3d")
         editor.tree.set_checked(editor.tree.channel_ids(), True)
 
+    def cape(self) -> None:
+        """The 3D tab at frame 150 framed on Walker, its cape trailing, the Cloth dock in front."""
+        self.tab("3D")
+        self.ctx.set_frame(150.0)
+        dock(self.window, "clothDock").raise_()
+        self.window.cloth_panel.asset.setCurrentText("cape")
+        view = self.window.viewport3d
+        self.ctx.select("walker", "")
+        view.frame_selection()
+        view.camera.orbit(-55.0, 8.0)
+        view.camera.zoom(1.15)
+        self.ctx.select("", "")
+        view.update()
+        settle(self.app, 1.0)
+        self.grab_window("cape")
+
     def viewport_shadow(self) -> None:
         """The 3D tab with the Shadow box ticked (a real click), the axes shown with a real X
         key press, and the camera fields open over the view's corner; the screen is grabbed so
@@ -310,6 +327,32 @@ class Shooter:
         self.grab_widget(d, "joint_tree")
         d.setFloating(False)
         layout_for_2d(self.window)
+
+    def outliner(self) -> None:
+        """The outliner with a cloth added, one asset locked and the fill light off (undone after)."""
+        from qtanimator.document import outliner
+        from qtanimator.document.cloth import add_cloth_command
+
+        doc = self.ctx.doc
+        steps = self.ctx.undo_stack.count()
+        if not any(a.kind == "cloth" for a in doc.assets.values()):
+            self.ctx.push(add_cloth_command(doc))
+        first = next(iter(doc.assets))
+        self.ctx.push(outliner.set_flag_command(doc, first, outliner.LOCKED, True))
+        self.ctx.push(outliner.set_flag_command(doc, "light2", outliner.HIDDEN, True))
+        self.ctx.select("arm", "")
+        d = dock(self.window, "jointTreeDock")
+        d.setFloating(True)
+        d.resize(380, 460)
+        tree = self.window.joint_tree.tree
+        for i in range(tree.topLevelItemCount()):
+            tree.topLevelItem(i).setExpanded(False)
+        tree.follow_selection()
+        self.grab_widget(d, "outliner")
+        d.setFloating(False)
+        layout_for_2d(self.window)
+        while self.ctx.undo_stack.count() > steps:
+            self.ctx.undo_stack.undo()
 
     def cloth_panel(self) -> None:
         self.tab("3D")
@@ -506,8 +549,9 @@ def main(argv: list[str] | None = None) -> int:
     os.environ["QTANIMATOR_SETTINGS_DIR"] = settings_dir
     try:
         shooter = Shooter(ns.out)
+        # gltf_clips last: it replaces the demo
         order = ["main_window", "pendulum_properties", "curve_editor", "viewport_3d", "viewport_shadow", "joint_tree",
-                 "cloth_panel", "export_dialog", "gltf_clips"]  # gltf_clips last: it replaces the demo
+                 "outliner", "cloth_panel", "cape", "export_dialog", "gltf_clips"]
         for name in order:
             if ns.only and name not in ns.only:
                 continue

@@ -19,6 +19,11 @@ Model
 * Collisions with a ground plane ``y = ground_height`` and spheres: particles are projected
   to the surface (plus ``collision_margin``), the normal velocity is reflected with the
   restitution and the tangential velocity loses Coulomb friction.
+* Moving capsules (:meth:`Cloth.set_capsules`: segments with a radius, e.g. a character's
+  bones): after every substep a particle inside one is pushed out to ``radius + margin``
+  along the normal from the segment (the deepest capsule first, three passes where capsules
+  overlap) and the inward normal component of its velocity is removed. The capsules move
+  linearly from their start to their end place over the substeps of the next step.
 * Kinematic particles: the pinned set (moved rigidly by :meth:`Cloth.move_pins`) and the
   grabbed particle. They move linearly to their targets over the substeps of the next
   :meth:`Cloth.step` and land on them exactly.
@@ -480,6 +485,8 @@ class Cloth:
         self._air: FloatArray | None = None
         self._wind_cache: FloatArray | None = None
         self._inv_mass_h: tuple[float, FloatArray] | None = None
+        self._capsules: tuple[FloatArray, FloatArray, FloatArray, FloatArray, FloatArray] | None = None
+        self._capsules_now: tuple[FloatArray, FloatArray, FloatArray] | None = None
 
     def _wind_field(self) -> FloatArray:
         """The steady wind at every particle, (N, 3) (the fused kernel wants an array)."""
@@ -678,6 +685,56 @@ class Cloth:
             self.positions[self._pin_index] = self.pin_targets
             self.velocities[self._pin_index] = 0.0
 
+    def set_pin_targets(self, targets: Any) -> None:
+        """Where the pinned particles are at the end of the next :meth:`step` (they land
+        there exactly), in the order of :attr:`pinned_indices`. A character's joint drives
+        an attached cloth this way."""
+        t = np.asarray(targets, dtype=np.float64)
+        if t.shape != (len(self._pin_index), 3):
+            raise ValueError(f"pin targets must be ({len(self._pin_index)}, 3), not {t.shape}")
+        self.pin_targets = t.copy()
+
+    def set_capsules(self, a: Any, b: Any, radius: Any, a_start: Any = None, b_start: Any = None) -> None:
+        """Capsule colliders for the next :meth:`step`: segments ``a[k] → b[k]`` (K, 3) with
+        ``radius[k]``, where they are at the end of the step; ``a_start`` / ``b_start`` where
+        they are at its start (default: already there). An empty K removes them."""
+        end_a = np.asarray(a, dtype=np.float64).reshape(-1, 3)
+        end_b = np.asarray(b, dtype=np.float64).reshape(-1, 3)
+        rad = np.asarray(radius, dtype=np.float64).reshape(-1)
+        if not (len(end_a) == len(end_b) == len(rad)):
+            raise ValueError("capsule ends and radii must have the same length")
+        if len(rad) and not (np.isfinite(end_a).all() and np.isfinite(end_b).all() and (rad > 0).all()):
+            raise ValueError("capsules need finite ends and positive radii")
+        if len(rad) == 0:
+            self._capsules = self._capsules_now = None
+            return
+        sa = end_a if a_start is None else np.asarray(a_start, dtype=np.float64).reshape(-1, 3)
+        sb = end_b if b_start is None else np.asarray(b_start, dtype=np.float64).reshape(-1, 3)
+        if sa.shape != end_a.shape or sb.shape != end_b.shape:
+            raise ValueError("capsule start and end places must have the same shape")
+        self._capsules = (sa.copy(), sb.copy(), end_a.copy(), end_b.copy(), rad.copy())
+        self._capsules_now = (end_a.copy(), end_b.copy(), rad.copy())
+
+    def capsule_penetration(self) -> float:
+        """The deepest a free particle lies inside a capsule (at its end place), in metres
+        (≤ 0: none is inside)."""
+        if self._capsules is None:
+            return -math.inf
+        _, _, a, b, r = self._capsules
+        _, _, _, depth = _capsule_depths(self.positions, a, b, r)
+        free = np.ones(self.n, dtype=bool)
+        free[self._pin_index] = False
+        return float(depth[free].max()) if free.any() else -math.inf
+
+    def energy(self) -> tuple[float, float, float]:
+        """(kinetic, gravitational above y = 0, spring) energy in joules."""
+        m = self.particle_mass
+        kinetic = 0.5 * m * float(np.einsum("ij,ij->", self.velocities, self.velocities))
+        gravity = m * self.params.gravity * float(self.positions[:, 1].sum())
+        stretch = self.spring_lengths() - self.rest_lengths
+        spring = 0.5 * float(np.sum(self._spring_k * stretch * stretch))
+        return kinetic, gravity, spring
+
     @property
     def pinned_indices(self) -> IntArray:
         """Indices of the pinned particles, in the order of :attr:`pin_targets`."""
@@ -745,6 +802,11 @@ class Cloth:
                     self._air = None
                     raise ClothStepCancelled(f"cloth step cancelled at t = {self.time:.4f} s")
                 kin_pos = kin_end if s == substeps else kin_start + (kin_end - kin_start) * (s / substeps)
+                if self._capsules is not None:
+                    ca0, cb0, ca1, cb1, cr = self._capsules
+                    f = s / substeps
+                    self._capsules_now = ((ca1, cb1, cr) if s == substeps else
+                                          (ca0 + (ca1 - ca0) * f, cb0 + (cb1 - cb0) * f, cr))
                 if self.params.integrator == "implicit":
                     self._implicit_substep(h, kin_idx, kin_pos, kin_vel)
                 else:
@@ -1019,6 +1081,24 @@ class Cloth:
             # A relative 1e-12 outside the surface, so rounding never leaves a point inside.
             x[idx] = centre + normal * (rad * (1.0 + 1e-12))
             self._respond(idx, normal, restitution, friction)
+        if self._capsules_now is not None:
+            self._collide_capsules(kin_idx, *self._capsules_now)
+
+    def _collide_capsules(self, kin_idx: IntArray, a: FloatArray, b: FloatArray, radius: FloatArray) -> None:
+        """Push free particles out of the capsules to radius + margin; drop inward velocity."""
+        x, v = self.positions, self.velocities
+        reach = radius + self.params.collision_margin
+        for _ in range(3):   # overlapping capsules: a push out of one may end in another
+            closest, normal, which, depth = _capsule_depths(x, a, b, reach)
+            if len(kin_idx):
+                depth[kin_idx] = -math.inf
+            hit = depth > 0
+            if not hit.any():
+                return
+            idx = np.flatnonzero(hit)
+            x[idx] = closest[idx] + normal[idx] * (reach[which[idx]] * (1.0 + 1e-12))[:, None]
+            vn = np.einsum("ij,ij->i", v[idx], normal[idx])
+            v[idx] -= np.minimum(vn, 0.0)[:, None] * normal[idx]
 
     def _respond(self, idx: IntArray, normal: FloatArray, restitution: float, friction: float) -> None:
         v = self.velocities
@@ -1063,6 +1143,31 @@ class Cloth:
         msg = (f"The implicit cloth solver blew up at t = {when:.3f} s. Lower 'wind', 'turbulence' or "
                f"'drag_coefficient', or raise 'substeps' (now {substeps} a frame).")
         return ClothBlowUp(msg, "wind", when)
+
+
+def _capsule_depths(x: FloatArray, a: FloatArray, b: FloatArray,
+                    radius: FloatArray) -> tuple[FloatArray, FloatArray, IntArray, FloatArray]:
+    """For every point: the closest point on its deepest capsule's segment, the outward unit
+    normal, that capsule's index and the depth ``radius − distance`` (> 0: inside)."""
+    ab = b - a
+    ab2 = np.einsum("kj,kj->k", ab, ab)
+    ap = x[:, None, :] - a[None, :, :]
+    t = np.clip(np.einsum("nkj,kj->nk", ap, ab) / np.where(ab2 > 0, ab2, 1.0), 0.0, 1.0)
+    closest = a[None, :, :] + t[:, :, None] * ab[None, :, :]
+    d = x[:, None, :] - closest
+    dist = np.sqrt(np.einsum("nkj,nkj->nk", d, d))
+    pen = radius[None, :] - dist
+    k = np.argmax(pen, axis=1)
+    rows = np.arange(len(x))
+    dk, lk = d[rows, k], dist[rows, k]
+    normal = np.empty_like(dk)
+    ok = lk > 1e-12
+    normal[ok] = dk[ok] / lk[ok, None]
+    # On the axis itself: any direction across the segment.
+    across = np.cross(ab[k[~ok]], np.array([0.0, 0.0, 1.0]))
+    across[np.einsum("ij,ij->i", across, across) < 1e-24] = (1.0, 0.0, 0.0)
+    normal[~ok] = across / np.linalg.norm(across, axis=1)[:, None] if len(across) else across
+    return closest[rows, k], normal, k.astype(np.int64), pen[rows, k]
 
 
 def _dot(a: FloatArray, b: FloatArray) -> float:

@@ -78,12 +78,21 @@ def end_position(skeleton: Skeleton, values: npt.ArrayLike, end: int) -> FloatAr
     return np.asarray(w[end, :3, 3], dtype=np.float64).copy()
 
 
+def effector(world: FloatArray, end: int, offset: npt.ArrayLike | None = None) -> FloatArray:
+    """The end effector ``W_end · offset`` (the end's origin when ``offset`` is None)."""
+    if offset is None:
+        return np.asarray(world[end, :3, 3], dtype=np.float64).copy()
+    return np.asarray(world[end, :3, :3] @ np.asarray(offset, dtype=np.float64).reshape(3) + world[end, :3, 3],
+                      dtype=np.float64)
+
+
 def jacobian(skeleton: Skeleton, values: npt.ArrayLike, dofs: Sequence[DofRef],
-             end: int) -> tuple[FloatArray, FloatArray]:
-    """``(p_end (3,), J (3, len(dofs)))`` for the DOF values ``values`` (J, 3)."""
+             end: int, offset: npt.ArrayLike | None = None) -> tuple[FloatArray, FloatArray]:
+    """``(p_end (3,), J (3, len(dofs)))`` for the DOF values ``values`` (J, 3); ``p_end``
+    is :func:`effector` (the end's own DOFs may be in ``dofs`` when ``offset`` is given)."""
     v = np.asarray(values, dtype=np.float64).reshape(len(skeleton.joints), 3)
     world = skeleton.world_matrices(v)
-    p_end = world[end, :3, 3].copy()
+    p_end = effector(world, end, offset)
     jac = np.zeros((3, len(dofs)))
     root = np.eye(4) if skeleton.placement is None else skeleton.placement.copy()
     root[:3, 3] += root[:3, :3] @ skeleton.root_translation
@@ -110,10 +119,13 @@ def jacobian(skeleton: Skeleton, values: npt.ArrayLike, dofs: Sequence[DofRef],
 
 def solve_ik(skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequence[DofRef] | None = None,
              chain_length: int = 3, damping: float = 0.05, iterations: int = 40, tolerance: float = 1e-5,
-             max_step: float = 0.25, values: npt.ArrayLike | None = None) -> IKResult:
+             max_step: float = 0.25, values: npt.ArrayLike | None = None,
+             offset: npt.ArrayLike | None = None) -> IKResult:
     """Move joint ``end`` towards ``target`` by damped least squares within the DOF limits.
 
-    ``dofs`` defaults to :func:`chain_dofs` (``chain_length`` ancestors). ``values`` (J, 3)
+    ``offset`` (3,) is a point in the end joint's frame to move instead of its origin (the
+    effector ``W_end · offset``: a clicked point of the skin); then the end's own DOFs may
+    be in ``dofs``. ``dofs`` defaults to :func:`chain_dofs` (``chain_length`` ancestors). ``values`` (J, 3)
     starts from other DOF values than the skeleton's. ``max_step`` caps the largest
     per-iteration angle change (radians).
     """
@@ -131,11 +143,12 @@ def solve_ik(skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequence
             out[j, a] = x
         return out
 
-    positions = skeleton.world_matrices(q_all)[:, :3, 3]
-    reach = max([float(np.linalg.norm(positions[end] - positions[j])) for j, _a in dof_list] + [1e-6])
+    world0 = skeleton.world_matrices(q_all)
+    positions, tip = world0[:, :3, 3], effector(world0, end, offset)
+    reach = max([float(np.linalg.norm(tip - positions[j])) for j, _a in dof_list] + [1e-6])
     lam2 = (damping * reach) ** 2
 
-    p, jac = jacobian(skeleton, write(q), dof_list, end)
+    p, jac = jacobian(skeleton, write(q), dof_list, end, offset)
     err = float(np.linalg.norm(goal - p))
     it = 0
     for it in range(1, iterations + 1):
@@ -158,14 +171,14 @@ def solve_ik(skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequence
         if biggest > max_step:
             dq *= max_step / biggest
         q_new = np.clip(q + dq, lo, hi)
-        p_new, jac_new = jacobian(skeleton, write(q_new), dof_list, end)
+        p_new, jac_new = jacobian(skeleton, write(q_new), dof_list, end, offset)
         err_new = float(np.linalg.norm(goal - p_new))
         if err_new > err and biggest < 1e-9:
             break
         if err_new > err:
             # overshoot: halve the step once and accept whatever is better
             q_half = np.clip(q + dq / 2, lo, hi)
-            p_half, jac_half = jacobian(skeleton, write(q_half), dof_list, end)
+            p_half, jac_half = jacobian(skeleton, write(q_half), dof_list, end, offset)
             err_half = float(np.linalg.norm(goal - p_half))
             if err_half >= err:
                 break

@@ -27,6 +27,11 @@ a DOF down to ``end``; the frame above it is fixed for the whole solve.
   (law of cosines, solved exactly for the hinge), then the first joint turns the triangle
   onto the target, the knee kept on the side of ``pole`` (a world point; default: where the
   knee is now). With limits or DOFs that cannot make that exact, CCD sweeps finish the solve.
+
+Every solver takes an optional ``offset``: the effector is then the point ``W_end · offset``
+(a clicked point of the skin in the end joint's frame) instead of the end's origin. It is
+a virtual child of the end with no DOFs, so the end's own DOFs move it like an ancestor's
+(two-bone: the end is the middle joint, its parent the first).
 """
 
 from __future__ import annotations
@@ -175,15 +180,22 @@ class _PathChain:
     """The DOF values of one solve and the forward kinematics of its path."""
 
     def __init__(self, skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequence[DofRef] | None,
-                 chain_length: int, values: npt.ArrayLike | None) -> None:
+                 chain_length: int, values: npt.ArrayLike | None, offset: npt.ArrayLike | None = None) -> None:
         self.skeleton = skeleton
         self.end = end
         self.goal = np.asarray(target, dtype=np.float64).reshape(3)
         self.v = skeleton.dof_values() if values is None else np.array(values, dtype=np.float64).reshape(-1, 3)
         dof_list = list(chain_dofs(skeleton, end, chain_length) if dofs is None else dofs)
         self.dofs = dof_list
+        # With an offset the effector is a virtual child ``tip`` of the end (index past the
+        # joints, no DOFs, at ``offset`` in the end's frame): the path ends there and the
+        # end's own DOFs move it like any ancestor's.
+        self.tip: int | None = None if offset is None else len(skeleton.joints)
         ancestors: list[int] = []
-        j = skeleton.joints[end].parent
+        if self.tip is not None:
+            ancestors.append(end)
+            end = self.tip
+        j = skeleton.joints[self.end].parent
         while j is not None:
             ancestors.append(j)
             j = skeleton.joints[j].parent
@@ -207,12 +219,19 @@ class _PathChain:
             for a in reversed(above):
                 base = base @ local[a]
         self.base = base
-        self.orders = {j: skeleton.joints[j].rotation_order or skeleton.rotation_order for j in self.path}
-        self.offsets = {j: skeleton.joints[j].offset + skeleton.joints[j].translation for j in self.path}
-        self.scales = {j: skeleton.joints[j].scale for j in self.path}
+        joints = [j for j in self.path if j != self.tip]
+        self.orders = {j: skeleton.joints[j].rotation_order or skeleton.rotation_order for j in joints}
+        self.offsets = {j: skeleton.joints[j].offset + skeleton.joints[j].translation for j in joints}
+        self.scales = {j: skeleton.joints[j].scale for j in joints}
+        if self.tip is not None:
+            self.orders[self.tip] = "xyz"
+            self.offsets[self.tip] = np.asarray(offset, dtype=np.float64).reshape(3).copy()
+            self.scales[self.tip] = np.ones(3)
 
     # ------------------------------------------------------------------ kinematics
     def rotation(self, j: int) -> FloatArray:
+        if j == self.tip:
+            return np.eye(3)
         return _euler_matrix(self.v[j].tolist(), self.orders[j])
 
     def local(self, j: int) -> FloatArray:
@@ -351,9 +370,9 @@ def _finite(target: npt.ArrayLike) -> bool:
 
 
 def _unchanged(skeleton: Skeleton, end: int, dofs: Sequence[DofRef] | None, chain_length: int,
-               values: npt.ArrayLike | None) -> IKResult:
+               values: npt.ArrayLike | None, offset: npt.ArrayLike | None = None) -> IKResult:
     """The result for a target that is not a point (NaN or infinite): nothing moves."""
-    return _PathChain(skeleton, end, np.zeros(3), dofs, chain_length, values).result(0, math.nan)
+    return _PathChain(skeleton, end, np.zeros(3), dofs, chain_length, values, offset).result(0, math.nan)
 
 
 def _ccd_loop(chain: _PathChain, iterations: int, tolerance: float, accelerate: bool, done: int = 0) -> IKResult:
@@ -375,26 +394,28 @@ def _ccd_loop(chain: _PathChain, iterations: int, tolerance: float, accelerate: 
 
 def solve_ccd(skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequence[DofRef] | None = None,
               chain_length: int = 3, iterations: int = 100, tolerance: float = 1e-5,
-              values: npt.ArrayLike | None = None, accelerate: bool = True) -> IKResult:
+              values: npt.ArrayLike | None = None, accelerate: bool = True,
+              offset: npt.ArrayLike | None = None) -> IKResult:
     """Move joint ``end`` towards ``target`` by CCD over the hinge DOFs (at most
     ``iterations`` sweeps), within the DOF limits. Arguments as
-    :func:`qtanimator.core.ik3d.solve_ik`."""
+    :func:`qtanimator.core.ik3d.solve_ik` (``offset``: the effector in the end's frame)."""
     if not _finite(target):
-        return _unchanged(skeleton, end, dofs, chain_length, values)
-    chain = _PathChain(skeleton, end, target, dofs, chain_length, values)
+        return _unchanged(skeleton, end, dofs, chain_length, values, offset)
+    chain = _PathChain(skeleton, end, target, dofs, chain_length, values, offset)
     return _ccd_loop(chain, iterations, tolerance, accelerate)
 
 
 def solve_fabrik(skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequence[DofRef] | None = None,
                  chain_length: int = 3, iterations: int = 100, tolerance: float = 1e-5,
-                 values: npt.ArrayLike | None = None, accelerate: bool = True) -> IKResult:
-    """Move joint ``end`` towards ``target`` by FABRIK on the path's positions (at most
-    ``iterations`` backward + forward passes), the positions converted back to DOF values
-    within their limits after every pass (then a pattern move in DOF space, as CCD's);
-    the best pass is returned."""
+                 values: npt.ArrayLike | None = None, accelerate: bool = True,
+                 offset: npt.ArrayLike | None = None) -> IKResult:
+    """Move joint ``end`` (or the point ``offset`` in its frame) towards ``target`` by
+    FABRIK on the path's positions (at most ``iterations`` backward + forward passes), the
+    positions converted back to DOF values within their limits after every pass (then a
+    pattern move in DOF space, as CCD's); the best pass is returned."""
     if not _finite(target):
-        return _unchanged(skeleton, end, dofs, chain_length, values)
-    chain = _PathChain(skeleton, end, target, dofs, chain_length, values)
+        return _unchanged(skeleton, end, dofs, chain_length, values, offset)
+    chain = _PathChain(skeleton, end, target, dofs, chain_length, values, offset)
     if not chain.free:
         return chain.result(0)
     frames = chain.frames()
@@ -445,10 +466,12 @@ def solve_fabrik(skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequ
     return chain.result(it)
 
 
-def two_bone_joints(skeleton: Skeleton, end: int, dofs: Sequence[DofRef]) -> tuple[int, int] | None:
+def two_bone_joints(skeleton: Skeleton, end: int, dofs: Sequence[DofRef],
+                    tip: bool = False) -> tuple[int, int] | None:
     """``(first, middle)`` when ``dofs`` belong to exactly the end's grandparent and parent
-    (the two-bone case), else None."""
-    middle = skeleton.joints[end].parent
+    (the two-bone case), else None. With ``tip`` (an effector offset in the end's frame)
+    the end itself is the middle joint and its parent the first."""
+    middle = end if tip else skeleton.joints[end].parent
     first = None if middle is None else skeleton.joints[middle].parent
     if middle is None or first is None:
         return None
@@ -457,21 +480,30 @@ def two_bone_joints(skeleton: Skeleton, end: int, dofs: Sequence[DofRef]) -> tup
 
 def solve_two_bone(skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequence[DofRef] | None = None,
                    pole: npt.ArrayLike | None = None, tolerance: float = 1e-5, iterations: int = 100,
-                   values: npt.ArrayLike | None = None) -> IKResult:
+                   values: npt.ArrayLike | None = None, offset: npt.ArrayLike | None = None) -> IKResult:
     """The analytic two-bone solution (see the module docstring). ``dofs`` default to the
     free DOFs of the end's parent and grandparent; ValueError when they are not exactly
-    those joints' (:func:`two_bone_joints`). ``pole`` is a world point on the side the
+    those joints' (:func:`two_bone_joints`). With ``offset`` (the effector in the end's
+    frame) the end and its parent are the two joints. ``pole`` is a world point on the side the
     middle joint should bend to (default: the side it bends to now). When limits or
     missing DOFs keep the analytic pose from the target, at most ``iterations`` CCD sweeps
     follow. A zero-length bone leaves it all to CCD."""
-    dof_list = list(chain_dofs(skeleton, end, 2) if dofs is None else dofs)
-    pair = two_bone_joints(skeleton, end, dof_list)
+    tip = offset is not None
+    if dofs is not None:
+        dof_list = list(dofs)
+    elif tip:
+        parent = skeleton.joints[end].parent
+        dof_list = [(j, a) for j in (end, parent) if j is not None
+                    for a, d in enumerate(skeleton.joints[j].dofs) if d.max - d.min > 1e-12]
+    else:
+        dof_list = list(chain_dofs(skeleton, end, 2))
+    pair = two_bone_joints(skeleton, end, dof_list, tip)
     if pair is None:
         raise ValueError("the two-bone solver needs DOFs of exactly the end's parent and grandparent")
     first, middle = pair
     if not _finite(target):
-        return _unchanged(skeleton, end, dof_list, 2, values)
-    chain = _PathChain(skeleton, end, target, dof_list, 2, values)
+        return _unchanged(skeleton, end, dof_list, 2, values, offset)
+    chain = _PathChain(skeleton, end, target, dof_list, 2, values, offset)
     frames = chain.frames()
     start, start_error = chain.v.copy(), chain.error(frames[-1][:3, 3])
     base = [chain.base, *frames[:-1]]   # each path joint's parent world matrix

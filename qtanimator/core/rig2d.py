@@ -141,6 +141,19 @@ class Pose:
     world: FloatArray
     pivots: FloatArray
     world_angles: FloatArray
+    #: The authored placement P (3×3) already folded into ``world`` and ``pivots`` (None:
+    #: none). ``angles``, ``translation`` and ``world_angles`` stay in the character's frame.
+    placement: FloatArray | None = None
+
+    def placed(self, placement: npt.ArrayLike | None) -> Pose:
+        """This pose seen through a placement P: world matrices P · W, pivots P · p."""
+        if placement is None:
+            return self
+        m = np.asarray(placement, dtype=np.float64).reshape(3, 3)
+        world = m @ self.world
+        pivots = self.pivots @ m[:2, :2].T + m[:2, 2]
+        total = m if self.placement is None else m @ self.placement
+        return Pose(self.angles, self.translation, world, pivots, self.world_angles, total)
 
     def to_world(self, joint: int, local_point: npt.ArrayLike) -> FloatArray:
         """A rest-pose point of ``joint`` mapped to its current position."""
@@ -152,6 +165,8 @@ class Pose:
         """Inverse of :meth:`to_world` (the IK source point of a right-press)."""
         p = np.asarray(world_point, dtype=np.float64)
         m = self.world[joint]
+        if self.placement is not None:  # a scaled placement: not a rotation any more
+            return np.asarray(np.linalg.solve(m[:2, :2], p - m[:2, 2]), dtype=np.float64)
         return np.asarray(m[:2, :2].T @ (p - m[:2, 2]), dtype=np.float64)
 
 

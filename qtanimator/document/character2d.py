@@ -67,6 +67,7 @@ from qtanimator.document.document import (
 from qtanimator.document.ik_settings import IK_DEFAULTS as IK_DEFAULTS
 from qtanimator.document.ik_settings import ik_setting as ik_setting
 from qtanimator.document.ik_settings import solve_character
+from qtanimator.document.placement import PLACEMENT, matrix2d
 from qtanimator.document.pose import pending_value, pending_values
 from qtanimator.document.simulation import SimulationWorker, ui_idle
 
@@ -118,6 +119,7 @@ def add_characters_command(doc: Document, path: str | Path, new_project_range: b
                    and doc.frame_range == NEW_PROJECT_RANGE)
     taken = set(doc.assets)
     commands: list[Command] = []
+    offset = _beside_offset(doc, chars)
     for i, ch in enumerate(chars):
         asset_id = doc.unique_asset_id(ch.name)
         k = 2
@@ -126,7 +128,10 @@ def add_characters_command(doc: Document, path: str | Path, new_project_range: b
             asset_id = f"{base}_{k}"
             k += 1
         taken.add(asset_id)
-        asset = Asset(asset_id, ASSET_KIND, source, {"index": i})
+        props: dict[str, Any] = {"index": i}
+        if offset is not None:  # beside the characters already there (issue 14)
+            props[PLACEMENT] = {"translate": [float(offset[0]), float(offset[1])], "rotate": 0.0, "scale": 1.0}
+        asset = Asset(asset_id, ASSET_KIND, source, props)
         commands.append(AddAsset(asset, ch))
     text = commands[0].text if len(commands) == 1 else f"Add {len(commands)} characters"
     if new_project and commands:
@@ -135,6 +140,32 @@ def add_characters_command(doc: Document, path: str | Path, new_project_range: b
     if len(commands) == 1:
         return commands[0]
     return Macro(text, commands)
+
+
+def shown_bounds(doc: Document, asset_id: str, time: float = 0.0) -> tuple[float, float, float, float]:
+    """(xmin, ymin, xmax, ymax) of the character's setup pose at its position and placement
+    at ``time`` (what an import places new characters beside; nothing is simulated)."""
+    ch = character(doc, asset_id)
+    pose = ch.pose(np.zeros(len(ch.joints)), translation(doc, asset_id, time))
+    return ch.bounds(pose.placed(placement_matrix(doc, asset_id)))
+
+
+def _beside_offset(doc: Document, chars: list[Character]) -> FloatArray | None:
+    """The translation that puts newly read characters (keeping their layout in the file)
+    to the right of the document's 2D characters, bottoms aligned; None when there are none."""
+    existing = [shown_bounds(doc, aid) for aid in character_assets(doc) if aid in doc.runtime]
+    if not existing or not chars:
+        return None
+    new = [c.bounds() for c in chars]
+    right = max(b[2] for b in existing)
+    bottom = max(b[3] for b in existing)
+    left = min(b[0] for b in new)
+    height = max(max(b[3] for b in new) - min(b[1] for b in new), 1.0)
+    return np.array([right + BESIDE_GAP * height - left, bottom - max(b[3] for b in new)])
+
+
+#: The gap between an imported 2D character and the ones there, as a fraction of its height.
+BESIDE_GAP = 0.1
 
 
 def character(doc: Document, asset_id: str) -> Character:
@@ -365,7 +396,28 @@ def evaluate_pose(doc: Document, asset_id: str, time: float, block: bool = True)
     simulated on the calling thread.
     """
     ch = character(doc, asset_id)
-    return ch.pose(joint_angles(doc, asset_id, time, block), translation(doc, asset_id, time))
+    pose = ch.pose(joint_angles(doc, asset_id, time, block), translation(doc, asset_id, time))
+    return pose.placed(placement_matrix(doc, asset_id))
+
+
+def placement_matrix(doc: Document, asset_id: str) -> FloatArray | None:
+    """The character's authored placement P (3×3, :mod:`qtanimator.document.placement`)
+    about its rest root pivot; None when it has none. Views draw, pick and drag through
+    :func:`evaluate_pose`, whose world matrices are P · W; IK maps its target back."""
+    asset = doc.assets.get(asset_id)
+    value = asset.properties.get(PLACEMENT) if asset is not None else None
+    if value is None:
+        return None
+    return matrix2d(value, character(doc, asset_id).rest_pivots[0])
+
+
+def to_character_frame(doc: Document, asset_id: str, point: npt.ArrayLike, vector: bool = False) -> FloatArray:
+    """A scene point (or with ``vector`` a displacement) in the character's own frame (P⁻¹)."""
+    p = np.asarray(point, dtype=np.float64).reshape(2)
+    m = placement_matrix(doc, asset_id)
+    if m is None:
+        return p.copy()
+    return np.asarray(np.linalg.solve(m[:2, :2], p if vector else p - m[:2, 2]), dtype=np.float64)
 
 
 # ------------------------------------------------------------------- key edits
@@ -456,6 +508,7 @@ def ik_values(doc: Document, asset_id: str, joint_index: int, local_point: npt.A
            else np.array(limits, dtype=np.float64).reshape(len(ch.joints), 2))
     lim[ch.dynamic] = (-math.inf, math.inf)
     limits = lim
+    target = to_character_frame(doc, asset_id, target)  # the solver works in the character's frame
     after = solve_character(doc, ch, before, position, joint_index, local_point, target, limits)
     # Whatever the solver, the result is within the limits (every solver clamps what it moves).
     after = np.where(ch.dynamic, after, np.clip(after, lim[:, 0], lim[:, 1]))

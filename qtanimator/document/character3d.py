@@ -63,6 +63,7 @@ from qtanimator.document.commands import (
     SetParameter,
 )
 from qtanimator.document.document import Asset, Document, channel_id
+from qtanimator.document.placement import PLACEMENT, matrix3d
 from qtanimator.document.pose import pending_values
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.attach import load_attach
@@ -90,14 +91,53 @@ ROTATION_MODES = ("quaternion", "euler")
 
 __all__ = [
     "ASSET_KIND", "BVH_POSITIONS", "BvhCharacter", "CLIP", "CLIP_STORE", "Character3D", "ClipSource", "MeshPart",
-    "QUAT_DOFS", "ROTATION_MODE", "ROTATION_MODES", "SCALE_DOFS", "TRANSLATE_DOFS", "active_clip",
+    "QUAT_DOFS", "ROTATION_MODE", "ROTATION_MODES", "SCALE_DOFS", "TRANSLATE_DOFS", "TextureImage", "active_clip",
     "add_character3d_command", "all_channel_ids", "bvh_positions", "bvh_positions_note", "channel_dofs",
     "channel_ids", "character", "clip_channels_of", "clip_from_document", "clip_range_command", "dof_channel_id",
     "dof_values", "ik_values", "joint_channel_names", "load_anim_command", "load_bvh_character", "load_character3d",
-    "load_character3d_asset", "new_key", "pose_channel_values", "pose_skeleton", "rotation_mode",
+    "load_character3d_asset", "load_skin_character", "new_key", "pose_channel_values", "pose_skeleton", "rotation_mode",
     "set_bvh_positions_command", "set_clip_command", "set_dof_command", "set_dofs_command",
-    "set_rotation_mode_command", "skinned_mesh", "with_rotation_mode", "world_matrices",
+    "set_rotation_mode_command", "skin_texture", "skinned_mesh", "with_rotation_mode", "world_matrices",
 ]
+
+
+@dataclass(eq=False)
+class TextureImage:
+    """An image a mesh is drawn with, as the file gave it: its bytes (a glTF embedded image)
+    or a ``path`` (a ``.skin`` material's texture beside the skin, a glTF ``uri``). The render
+    layer decodes it; undecodable or missing, it draws a checkerboard. ``wrap`` is
+    ``"repeat"`` or ``"clamp"`` (to the edge)."""
+
+    data: bytes | None = None
+    path: str | None = None
+    mime_type: str | None = None
+    name: str = ""
+    wrap: str = "repeat"
+
+    def read(self) -> bytes | None:
+        """The image's bytes (None when the file is missing or unreadable)."""
+        if self.data is not None:
+            return self.data
+        if self.path is None:
+            return None
+        try:
+            return Path(self.path).read_bytes()
+        except OSError:
+            return None
+
+
+def skin_texture(skin: Skin | None, skin_path: str | os.PathLike[str] | None) -> TextureImage | None:
+    """The image of a ``.skin``'s ``material { texture FILE }`` block: FILE beside the skin
+    (matched without regard to case when the exact name is absent). None without a block."""
+    material = getattr(skin, "material", None)
+    name = material.get("texture") if material else None
+    if not name or skin_path is None:
+        return None
+    folder = Path(skin_path).parent
+    path = folder / str(name)
+    if not path.is_file() and folder.is_dir():
+        path = next((p for p in sorted(folder.iterdir()) if p.name.lower() == Path(str(name)).name.lower()), path)
+    return TextureImage(path=str(path), name=str(name), wrap="clamp")
 
 
 @dataclass
@@ -117,6 +157,8 @@ class MeshPart:
     primitive: int = 0
     #: base colour (RGBA, linear) of the part's material
     color: tuple[float, float, float, float] = (0.8, 0.8, 0.8, 1.0)
+    #: the image of the material's base colour (drawn with the skin's texture coordinates)
+    texture: TextureImage | None = None
 
 
 @dataclass
@@ -152,6 +194,8 @@ class Character3D:
     palette: npt.NDArray[np.intp] | None = None
     #: Notes for the user from reading the file.
     notes: list[str] = field(default_factory=list)
+    #: The whole skin's image when it has no parts (a ``.skin`` material's texture).
+    texture: TextureImage | None = None
     _rest_quaternions: FloatArray | None = field(default=None, repr=False)
 
     @property
@@ -207,7 +251,19 @@ def load_character3d(skel_path: str | os.PathLike[str], skin_path: str | os.Path
         raise FormatError(f"the animation has {len(clip.channels)} channels, but a skeleton of "
                           f"{len(skeleton.joints)} joints takes at most {channel_count(len(skeleton.joints))} "
                           "(3 for the root position, then 3 per joint).", anim_path)
-    return Character3D(skeleton, skin, mesh, clip, faceted)
+    return Character3D(skeleton, skin, mesh, clip, faceted, texture=skin_texture(skin, skin_path))
+
+
+def load_skin_character(skin_path: str | os.PathLike[str]) -> Character3D:
+    """A ``.skin`` without a skeleton: its mesh as stored (the bind pose, positions in world
+    space) on one still root joint at the origin, every vertex on it with identity bind."""
+    stored = load_skin(skin_path)
+    n = stored.num_vertices
+    binding = SkinBinding(np.arange(n), np.zeros(n, dtype=np.intp), np.ones(n), n, 1)
+    skin = Skin(stored.positions, stored.triangles, binding, np.eye(4)[None], normals=stored.normals,
+                texcoords=stored.texcoords, material=stored.material)
+    skeleton = Skeleton([Joint("root")], "zyx", name=Path(skin_path).stem, dialect="balljoint")
+    return Character3D(skeleton, skin, texture=skin_texture(skin, skin_path))
 
 
 @dataclass(eq=False)
@@ -338,6 +394,8 @@ def _load_character3d_asset(asset: Asset) -> Character3D:
     if suffix == ".bvh":
         value = asset.properties.get(BVH_POSITIONS)
         return load_bvh_character(asset.source, value if value in POSITION_CONVENTIONS else None)[0]
+    if suffix == ".skin":
+        return load_skin_character(asset.source)
     if suffix in (".glb", ".gltf"):
         from qtanimator.document.import3d import load_gltf_character_asset
 
@@ -579,15 +637,17 @@ def set_dofs_command(doc: Document, asset_id: str, values: Mapping[tuple[int | N
 
 
 def ik_values(doc: Document, asset_id: str, joint: int, target: npt.ArrayLike, time: float,
-              dofs: list[tuple[int, int]]) -> dict[tuple[int | None, str | int], float]:
+              dofs: list[tuple[int, int]], offset: npt.ArrayLike | None = None
+              ) -> dict[tuple[int | None, str | int], float]:
     """Solve IK for ``joint`` towards ``target`` over ``dofs`` from the pose shown at
     ``time`` with the document's IK settings (:mod:`qtanimator.document.ik_settings`: the
     solver, two-bone for a two-joint chain): the new DOF values by (joint, axis). Both 3D
-    IK paths (keying and posing without keys) get their values here."""
+    IK paths (keying and posing without keys) get their values here. ``offset``: the
+    point of ``joint``'s frame to move (a clicked skin point; None: its origin)."""
     from qtanimator.document.ik_settings import solve_skeleton
 
     skel = pose_skeleton(doc, asset_id, time)
-    result = solve_skeleton(doc, skel, joint, np.asarray(target, dtype=np.float64), dofs)
+    result = solve_skeleton(doc, skel, joint, np.asarray(target, dtype=np.float64), dofs, offset)
     return {(j, axis): v for (j, axis), v in result.by_axis_name().items()}
 
 
@@ -769,6 +829,14 @@ def set_rotation_mode_command(doc: Document, asset_id: str, mode: str) -> Comman
 
 
 # -------------------------------------------------------------------- evaluation
+def authored_placement(doc: Document, asset_id: str) -> FloatArray | None:
+    """The 4×4 authored placement of the character (asset property ``placement``,
+    :mod:`qtanimator.document.placement`), None when it has none."""
+    asset = doc.assets.get(asset_id)
+    value = asset.properties.get(PLACEMENT) if asset is not None else None
+    return None if value is None else matrix3d(value)
+
+
 def pose_skeleton(doc: Document, asset_id: str, time: float) -> Skeleton:
     """A posed copy of the character's skeleton at ``time`` (channel values clamped; a
     pending, unkeyed pose at ``time`` is shown: see :mod:`qtanimator.document.pose`).
@@ -778,6 +846,9 @@ def pose_skeleton(doc: Document, asset_id: str, time: float) -> Skeleton:
     equivalent Euler angles."""
     ch = character(doc, asset_id)
     skel = ch.skeleton.copy()
+    placed = authored_placement(doc, asset_id)
+    if placed is not None:  # the authored placement goes on top of the file's (issue 14)
+        skel.placement = placed if skel.placement is None else placed @ skel.placement
     t = float(time)
     held = pending_values(doc, t)  # an unkeyed pose shown at this time (document.pose)
     channels = doc.channels
@@ -879,3 +950,14 @@ def skinned_mesh(doc: Document, asset_id: str, time: float) -> tuple[FloatArray,
         return skin_positions_and_normals(ch.skin, w)
     positions = skin_positions(ch.skin, w)
     return positions, vertex_normals(positions, ch.skin.triangles)
+
+
+def bounds(doc: Document, asset_id: str, time: float) -> tuple[FloatArray, FloatArray]:
+    """(lo, hi) world-space box of the character at ``time``: its joints and its skinned mesh."""
+    world = world_matrices(doc, asset_id, time)
+    points = [world[:, :3, 3]]
+    ch = character(doc, asset_id)
+    if ch.skin is not None:
+        points.append(skinned_mesh(doc, asset_id, time)[0])
+    pts = np.concatenate(points, axis=0)
+    return pts.min(axis=0), pts.max(axis=0)

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from qtanimator.core.cloth import Cloth, ClothBlowUp, ClothParams, ClothStepCancelled, FloatArray
+from qtanimator.document.cloth_attach import ClothDriver, build_driver, driver_key
 from qtanimator.document.commands import AddAsset, Command, SetAssetProperty
 from qtanimator.document.document import Asset, Document
 from qtanimator.formats.errors import FormatError
@@ -42,12 +43,20 @@ class ClothCache:
     """The runtime object of a cloth asset: a :class:`Cloth` and the positions of every
     frame simulated so far (read-only arrays; frame ``frame_start`` is the rest state)."""
 
-    def __init__(self, properties: dict[str, Any], fps: float = 60.0, frame_start: int = 0) -> None:
+    def __init__(self, properties: dict[str, Any], fps: float = 60.0, frame_start: int = 0,
+                 driver: ClothDriver | None = None) -> None:
         self.properties = copy.deepcopy(properties)
         self.params = ClothParams.from_dict(properties)
         self.fps = float(fps)
         self.frame_start = int(frame_start)
         self.cloth = Cloth(self.params)
+        #: The character joint and capsules an attached cloth follows (document.cloth_attach).
+        self.driver = driver
+        self.driver_key = None if driver is None else driver.key
+        self._local = np.zeros((0, 3))
+        if driver is not None:
+            self._local = driver.pin_locals(self.cloth)
+            driver.place(self.cloth, self._local)
         self.frames: list[FloatArray] = [self._freeze(self.cloth.positions)]
         self.error: ClothBlowUp | None = None
         self._lock = threading.Lock()
@@ -59,7 +68,11 @@ class ClothCache:
         return out
 
     def matches(self, properties: dict[str, Any], fps: float, frame_start: int) -> bool:
-        return self.properties == properties and self.fps == float(fps) and self.frame_start == int(frame_start)
+        # Hiding or locking a cloth in the outliner does not change its simulation.
+        def simulated(props: dict[str, Any]) -> dict[str, Any]:
+            return {k: v for k, v in props.items() if k not in ("hidden", "locked")}
+        return (simulated(self.properties) == simulated(properties) and self.fps == float(fps)
+                and self.frame_start == int(frame_start))
 
     @property
     def triangles(self) -> Any:
@@ -79,6 +92,8 @@ class ClothCache:
             if self.error is not None:
                 return False
             try:
+                if self.driver is not None:
+                    self.driver.apply(self.cloth, self._local, len(self.frames))
                 self.cloth.step(1.0 / self.fps, should_stop)
             except ClothStepCancelled:
                 return False
@@ -166,8 +181,11 @@ def cloth_cache(doc: Document, asset_id: str) -> ClothCache:
         raise ValueError(f"asset {asset_id!r} is a {asset.kind}, not a cloth")
     start = doc.frame_range[0]
     cache = doc.runtime.get(asset_id)
-    if not isinstance(cache, ClothCache) or not cache.matches(asset.properties, doc.fps, start):
-        cache = ClothCache(asset.properties, doc.fps, start)
+    key = driver_key(doc, asset.properties)
+    if (not isinstance(cache, ClothCache) or not cache.matches(asset.properties, doc.fps, start)
+            or cache.driver_key != key):
+        driver = build_driver(doc, asset.properties) if key is not None else None
+        cache = ClothCache(asset.properties, doc.fps, start, driver)
         doc.runtime[asset_id] = cache
     return cache
 

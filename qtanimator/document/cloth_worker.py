@@ -52,17 +52,23 @@ TARGET_PARAMETERS = frozenset({"frame_end"})
 def cloth_invalidations(doc: Document, change: DocumentChange) -> dict[str, float]:
     """Which cloth caches ``change`` invalidates, and from which frame on: ``{asset id: frame}``.
 
-    A cloth's simulation depends only on its own properties and on ``fps`` / ``frame_start``
-    (no channel drives it), so a cloth is touched when its asset was added, replaced or
-    removed, or the frame grid changed, and then from its first frame (``-inf``: everything).
-    Removed assets are included (their work is dropped). Channel changes touch no cloth;
-    when something does drive a cloth one day, this is the one function to extend.
+    A cloth's simulation depends on its own properties, on ``fps`` / ``frame_start`` and, when
+    it is attached to a character (``attach``), on that character's channels and properties;
+    a cloth is touched when its asset was added, replaced or removed, the frame grid changed,
+    or its character changed, and then from its first frame (``-inf``: everything).
+    Removed assets are included (their work is dropped).
     """
     cloths = {a for a, asset in doc.assets.items() if asset.kind == ASSET_KIND}
     if change.reset or change.parameters & GRID_PARAMETERS:
         touched = set(cloths) | set(change.assets)
     else:
         touched = set(change.assets)
+        # A cloth attached to a character (cloth_attach) follows its channels and properties.
+        drivers = set(change.assets) | change.channel_assets()
+        for aid in cloths:
+            value = doc.assets[aid].properties.get("attach")
+            if isinstance(value, dict) and value.get("asset") in drivers:
+                touched.add(aid)
     return {aid: -math.inf for aid in sorted(touched) if aid in cloths or aid not in doc.assets}
 
 

@@ -319,6 +319,52 @@ class RemoveAsset(Command):
             doc.apply_channel(cid, ch)
 
 
+class RenameAsset(Command):
+    """Give an asset a new id: its channels ``old/…`` become ``new/…`` and its parameters
+    ``old.…`` become ``new.…`` (those of a longer asset id such as ``old.b`` stay); the
+    asset keeps its place in the scene order and its loaded object. Undo puts everything
+    back exactly. The caller checks the name (``outliner.rename_command``)."""
+
+    def __init__(self, doc: Document, old: str, new: str) -> None:
+        if new in doc.assets and new != old:
+            raise ValueError(f"the name {new!r} is already in use")
+        self.old, self.new = old, new
+        self.asset = doc.assets[old]
+        self.runtime = doc.runtime.get(old)
+        self.index = list(doc.assets).index(old)
+        self.channels = dict(doc.channels_of(old))
+        longer = [aid + "." for aid in doc.assets if aid != old and aid.startswith(old + ".")]
+        self.parameters = {p: v for p, v in doc.parameters.items()
+                           if p.startswith(old + ".") and not any(p.startswith(x) for x in longer)}
+        self.text = f"Rename {old} to {new}"
+
+    def _move(self, doc: Document, src: str, dst: str) -> None:
+        def named(key: str, sep: str, aid: str) -> str:
+            return aid + sep + key[len(self.old) + 1:]
+
+        for cid in self.channels:
+            doc.apply_channel(named(cid, "/", src), None)
+        for p in self.parameters:
+            doc.apply_parameter(named(p, ".", src), None)
+        doc.apply_asset(src, None)
+        asset = self.asset if dst == self.old else Asset(dst, self.asset.kind, self.asset.source,
+                                                          self.asset.properties)
+        doc.apply_asset(dst, asset, self.runtime, index=self.index)
+        for cid, ch in self.channels.items():
+            doc.apply_channel(named(cid, "/", dst), ch)
+        for p, v in self.parameters.items():
+            doc.apply_parameter(named(p, ".", dst), v)
+
+    def do(self, doc: Document) -> None:
+        self._move(doc, self.old, self.new)
+
+    def undo(self, doc: Document) -> None:
+        self._move(doc, self.new, self.old)
+
+    def is_noop(self) -> bool:
+        return self.old == self.new
+
+
 class SetAssetProperty(Command):
     """Set one authored property of an asset (merges within a gesture)."""
 

@@ -17,6 +17,10 @@ The mapping (issue 21; docs/formats.md lists what is read):
   :class:`~qtanimator.core.skinning.Skin`. A skinned primitive keeps its skin's inverse
   bind matrices through the character's palette (each glTF skin has its own slots); a mesh
   without a skin rides rigidly on its node's joint. Parts keep their material's base colour.
+* **Textures.** A material's ``baseColorTexture`` becomes the part's
+  :class:`~qtanimator.document.character3d.TextureImage` (embedded bytes, or the ``uri``'s
+  file inside the file's folder); the render layer decodes it. Its base colour is the factor
+  (white without one).
 * **Clips.** Every animation is a :class:`ClipSource` named as in the file (``Animation
   <i>`` when unnamed) with its keys as they are: translation and scale keys become linear,
   stepped or cubic (fixed-slope Hermite, exactly glTF's CUBICSPLINE) keys; rotation keys
@@ -31,6 +35,7 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
+from urllib.parse import unquote
 
 import numpy as np
 import numpy.typing as npt
@@ -39,7 +44,15 @@ from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key
 from qtanimator.core.rotation import euler_from_matrices, matrices_to_quaternions, polar, quaternion_to_matrix
 from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skeleton
 from qtanimator.core.skinning import Skin, SkinBinding, vertex_normals
-from qtanimator.document.character3d import QUAT_DOFS, SCALE_DOFS, TRANSLATE_DOFS, Character3D, ClipSource, MeshPart
+from qtanimator.document.character3d import (
+    QUAT_DOFS,
+    SCALE_DOFS,
+    TRANSLATE_DOFS,
+    Character3D,
+    ClipSource,
+    MeshPart,
+    TextureImage,
+)
 from qtanimator.formats.gltf import GltfAnimation, GltfSampler, GltfScene
 
 FloatArray = npt.NDArray[np.float64]
@@ -141,7 +154,39 @@ def _material_color(scene: GltfScene, material: int | None) -> tuple[float, floa
             and all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in factor)):
         c = [min(max(float(x), 0.0), 1.0) for x in factor]
         return (c[0], c[1], c[2], c[3])
+    if _base_color_texture(scene, material) is not None:
+        return (1.0, 1.0, 1.0, 1.0)  # the specification's default factor: the texture as it is
     return DEFAULT_COLOR
+
+
+def _base_color_texture(scene: GltfScene, material: int | None) -> int | None:
+    """The image index of a material's ``baseColorTexture`` (None without one)."""
+    if material is None or not 0 <= material < len(scene.materials):
+        return None
+    pbr = scene.materials[material].get("pbrMetallicRoughness")
+    info = pbr.get("baseColorTexture") if isinstance(pbr, dict) else None
+    index = info.get("index") if isinstance(info, dict) else None
+    if not isinstance(index, int) or isinstance(index, bool) or not 0 <= index < len(scene.textures):
+        return None
+    source = scene.textures[index].get("source")
+    if not isinstance(source, int) or isinstance(source, bool) or not 0 <= source < len(scene.images):
+        return None
+    return source
+
+
+def _image_texture(scene: GltfScene, image: int, folder: Path | None) -> TextureImage:
+    """An image of the file: its embedded bytes, or its ``uri`` as a file inside the file's
+    folder (a path that leaves the folder, or a URL, stays unread: the checkerboard)."""
+    im = scene.images[image]
+    name = im.name or f"Image_{image}"
+    if im.data is not None:
+        return TextureImage(data=im.data, mime_type=im.mime_type, name=name)
+    path: str | None = None
+    if im.uri and folder is not None and "://" not in im.uri:
+        candidate = (folder / unquote(im.uri)).resolve()
+        if candidate.is_relative_to(folder.resolve()):
+            path = str(candidate)
+    return TextureImage(path=path, mime_type=im.mime_type, name=name)
 
 
 def _keys(sampler: GltfSampler, column: int, start: int = 0) -> list[Key]:
@@ -232,7 +277,8 @@ def character_from_gltf(scene: GltfScene, path: str | os.PathLike[str] | None = 
         notes.append(f"{len(sheared)} node matrices have a shear, which a joint cannot hold: "
                      f"{', '.join(sheared[:5])}.")
 
-    skin, parts, palette = _merged_skin(scene, joint_of, notes)
+    where = path if path is not None else scene.path
+    skin, parts, palette = _merged_skin(scene, joint_of, notes, Path(where).parent if where else None)
     keys = skeleton.joint_keys()
     clips = [_clip(scene, i, a, joint_of, keys, name)
              for i, (a, name) in enumerate(zip(scene.animations, _clip_names(scene)))]
@@ -250,8 +296,8 @@ def character_from_gltf(scene: GltfScene, path: str | os.PathLike[str] | None = 
     return GltfMapping(ch, order, notes)
 
 
-def _merged_skin(scene: GltfScene, joint_of: dict[int, int],
-                 notes: list[str]) -> tuple[Skin | None, list[MeshPart], npt.NDArray[np.intp] | None]:
+def _merged_skin(scene: GltfScene, joint_of: dict[int, int], notes: list[str],
+                 folder: Path | None = None) -> tuple[Skin | None, list[MeshPart], npt.NDArray[np.intp] | None]:
     """Every primitive of every mesh node in one skin, with its palette."""
     palette: list[int] = []
     ibms: list[FloatArray] = []
@@ -265,6 +311,7 @@ def _merged_skin(scene: GltfScene, joint_of: dict[int, int],
     b_slot: list[npt.NDArray[np.intp]] = []
     b_weight: list[FloatArray] = []
     parts: list[MeshPart] = []
+    images: dict[int, TextureImage] = {}  # one per image, shared by the parts that use it
     nv = nt = 0
     for n, node in enumerate(scene.nodes):
         if node.mesh is None:
@@ -307,8 +354,12 @@ def _merged_skin(scene: GltfScene, joint_of: dict[int, int],
                            else vertex_normals(p, tri))
             texcoords.append(None if prim.texcoords is None else np.asarray(prim.texcoords, dtype=np.float64))
             name = mesh.name or f"Mesh_{node.mesh}"
+            image = _base_color_texture(scene, prim.material)
+            texture = None
+            if image is not None:
+                texture = images.get(image) or images.setdefault(image, _image_texture(scene, image, folder))
             parts.append(MeshPart(name if len(mesh.primitives) == 1 else f"{name}.{pi}", nv, count, nt, len(tri),
-                                  skinned, n, node.mesh, pi, _material_color(scene, prim.material)))
+                                  skinned, n, node.mesh, pi, _material_color(scene, prim.material), texture))
             nv += count
             nt += len(tri)
     if not parts:

@@ -27,12 +27,16 @@ importing an export gives the same character back:
   document's channels over the frame range, time 0 at the range's start.
 
 Texture coordinates: a character read from glTF holds them as glTF does (origin top left),
-others as OpenGL does (origin bottom left, v flipped on export). Texture images are not kept
-by the document and are not written.
+others as OpenGL does (origin bottom left, v flipped on export). A part's image (a glTF
+baseColorTexture, a course skin's material texture) is embedded in the ``.glb`` as a buffer
+view with its mime type, PNG and JPEG as they are and other formats (BMP) converted to PNG,
+with a sampler and the material's ``baseColorTexture``; an image that is missing or cannot be
+read is left out.
 """
 
 from __future__ import annotations
 
+import io
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -41,10 +45,25 @@ import numpy.typing as npt
 
 from qtanimator.core.rotation import matrices_to_quaternions, polar
 from qtanimator.core.skinning import Skin, skin_positions
-from qtanimator.document.character3d import Character3D, MeshPart, character, clip_channels_of, clip_duration
+from qtanimator.document.character3d import (
+    Character3D,
+    MeshPart,
+    TextureImage,
+    character,
+    clip_channels_of,
+    clip_duration,
+)
 from qtanimator.document.document import Document
 from qtanimator.document.gltf_export_clips import clip_animation, rest_rotations
-from qtanimator.formats.gltf import CharacterExport, GltfMesh, GltfNode, GltfPrimitive, GltfScene, GltfSkin
+from qtanimator.formats.gltf import (
+    CharacterExport,
+    GltfImage,
+    GltfMesh,
+    GltfNode,
+    GltfPrimitive,
+    GltfScene,
+    GltfSkin,
+)
 
 FloatArray = npt.NDArray[np.float64]
 IntArray = npt.NDArray[np.int64]
@@ -148,7 +167,9 @@ def _node_order(ch: Character3D, units: list[_Unit], groups: list[_SkinGroup],
 def _units(ch: Character3D, asset_id: str, palette: npt.NDArray[Any]) -> list[_Unit]:
     skin = ch.skin
     assert skin is not None
-    parts = list(ch.parts) or [MeshPart(asset_id, 0, skin.num_vertices, 0, len(skin.triangles))]
+    parts = list(ch.parts) or [MeshPart(asset_id, 0, skin.num_vertices, 0, len(skin.triangles),
+                                        color=(1.0, 1.0, 1.0, 1.0) if ch.texture is not None else (0.8, 0.8, 0.8, 1.0),
+                                        texture=ch.texture)]
     units: list[_Unit] = []
     by_source: dict[tuple[int | None, int | None, int | None], _Unit] = {}
     rigid_joints: set[int] = set()
@@ -247,14 +268,17 @@ def _meshes(ch: Character3D, units: list[_Unit], unit_skins: dict[int, tuple[int
     """One mesh per unit (a primitive per part) on its node, and a material per colour."""
     skin = ch.skin
     assert skin is not None
-    colours: dict[tuple[float, ...], int] = {}
+    colours: dict[tuple[Any, ...], int] = {}
+    images: dict[int, int | None] = {}
     gltf_uv = ch.skeleton.dialect == "gltf"
     for u, unit in enumerate(units):
         prims = []
         for part in unit.parts:
-            material = colours.setdefault(tuple(part.color), len(colours))
+            image = part.texture if skin.texcoords is not None else None
+            texture = None if image is None else _texture(scene, image, images)
+            material = colours.setdefault((*part.color, texture), len(colours))
             if material == len(scene.materials):
-                scene.materials.append(_material(part))
+                scene.materials.append(_material(part, texture))
             if unit.slot is None:
                 prims.append(_skinned_primitive(skin, part, unit_skins[u][1], material, gltf_uv))
             else:
@@ -310,13 +334,53 @@ def _rigid_primitive(skin: Skin, part: MeshPart, slot: int, material: int, gltf_
     return GltfPrimitive(positions, tri, normals, _texcoords(skin, part, gltf_uv), material=material)
 
 
-def _material(part: MeshPart) -> dict[str, Any]:
+def _material(part: MeshPart, texture: int | None = None) -> dict[str, Any]:
     colour = [float(c) for c in part.color]
     m: dict[str, Any] = {"name": part.name, "pbrMetallicRoughness": {
         "baseColorFactor": colour, "metallicFactor": 0.0, "roughnessFactor": 1.0}}
+    if texture is not None:
+        m["pbrMetallicRoughness"]["baseColorTexture"] = {"index": texture}
     if colour[3] < 1.0:
         m["alphaMode"] = "BLEND"
     return m
+
+
+def _image_bytes(image: TextureImage) -> tuple[bytes, str] | None:
+    """The image as glTF may embed it: PNG and JPEG as they are, another format Pillow reads
+    (a course skin's BMP) converted to PNG; None when it is missing or unreadable."""
+    data = image.read()
+    if not data:
+        return None
+    if data.startswith(b"\x89PNG\r\n\x1a\n"):
+        return data, "image/png"
+    if data.startswith(b"\xff\xd8\xff"):
+        return data, "image/jpeg"
+    try:
+        from PIL import Image
+
+        with Image.open(io.BytesIO(data)) as im:
+            out = io.BytesIO()
+            im.convert("RGBA" if "A" in im.getbands() else "RGB").save(out, format="PNG")
+    except Exception:  # noqa: BLE001 - any undecodable image is left out, not an error
+        return None
+    return out.getvalue(), "image/png"
+
+
+def _texture(scene: GltfScene, image: TextureImage, done: dict[int, int | None]) -> int | None:
+    """The index of a texture (image and sampler) for ``image``, written once per image;
+    None when the image cannot be embedded (the part keeps its colour only)."""
+    key = id(image)
+    if key not in done:
+        embedded = _image_bytes(image)
+        if embedded is None:
+            done[key] = None
+        else:
+            scene.images.append(GltfImage(embedded[0], embedded[1], None, image.name))
+            wrap = 33071 if image.wrap == "clamp" else 10497  # CLAMP_TO_EDGE, REPEAT
+            scene.samplers.append({"magFilter": 9729, "minFilter": 9987, "wrapS": wrap, "wrapT": wrap})
+            scene.textures.append({"sampler": len(scene.samplers) - 1, "source": len(scene.images) - 1})
+            done[key] = len(scene.textures) - 1
+    return done[key]
 
 
 def _renormalisation_error(ch: Character3D) -> float:

@@ -100,33 +100,36 @@ def solve_character(doc: Document, character: Character, angles: npt.ArrayLike, 
                        damping=float(ik_setting(doc, "ik.damping")), stats=stats)
 
 
-def skeleton_solver(doc: Document, skeleton: Skeleton, joint: int, dofs: Sequence[ik3d.DofRef]) -> str:
+def skeleton_solver(doc: Document, skeleton: Skeleton, joint: int, dofs: Sequence[ik3d.DofRef],
+                    offset: npt.ArrayLike | None = None) -> str:
     """The solver a 3D drag on ``joint`` over ``dofs`` uses: ``"two_bone"``, ``"ccd"``,
-    ``"fabrik"`` or ``"dls"`` (also for ``handout``, which has no 3D form)."""
+    ``"fabrik"`` or ``"dls"`` (also for ``handout``, which has no 3D form). With an
+    ``offset`` (a point in ``joint``'s frame) two-bone means ``joint`` and its parent."""
     solver = _solver(doc)
     if (solver != "handout" and bool(ik_setting(doc, "ik.two_bone"))
-            and ik3d_methods.two_bone_joints(skeleton, joint, dofs) is not None):
+            and ik3d_methods.two_bone_joints(skeleton, joint, dofs, tip=offset is not None) is not None):
         return "two_bone"
     return solver if solver in ("ccd", "fabrik") else "dls"
 
 
 def solve_skeleton(doc: Document, skeleton: Skeleton, joint: int, target: npt.ArrayLike,
-                   dofs: Sequence[ik3d.DofRef]) -> ik3d.IKResult:
+                   dofs: Sequence[ik3d.DofRef], offset: npt.ArrayLike | None = None) -> ik3d.IKResult:
     """Solve a 3D drag on ``joint`` towards ``target`` over ``dofs`` with the document's
-    IK settings (the skeleton's current pose is the start)."""
-    solver = skeleton_solver(doc, skeleton, joint, dofs)
+    IK settings (the skeleton's current pose is the start). ``offset``: move that point of
+    ``joint``'s frame (a clicked skin point) instead of its origin."""
+    solver = skeleton_solver(doc, skeleton, joint, dofs, offset)
     goal = np.asarray(target, dtype=np.float64)
     iterations = int(ik_setting(doc, "ik.max_iterations"))
     if solver == "two_bone":
         return ik3d_methods.solve_two_bone(skeleton, joint, goal, dofs=dofs, tolerance=TOLERANCE_3D,
-                                           iterations=iterations)
+                                           iterations=iterations, offset=offset)
     if solver == "ccd":
         return ik3d_methods.solve_ccd(skeleton, joint, goal, dofs=dofs, iterations=iterations,
-                                      tolerance=TOLERANCE_3D)
+                                      tolerance=TOLERANCE_3D, offset=offset)
     if solver == "fabrik":
         return ik3d_methods.solve_fabrik(skeleton, joint, goal, dofs=dofs, iterations=iterations,
-                                         tolerance=TOLERANCE_3D)
-    return ik3d.solve_ik(skeleton, joint, goal, dofs=dofs)
+                                         tolerance=TOLERANCE_3D, offset=offset)
+    return ik3d.solve_ik(skeleton, joint, goal, dofs=dofs, offset=offset)
 
 
 __all__ = ["BEND_DIRECTIONS", "IK_DEFAULTS", "IK_SOLVERS", "character_solver", "ik_setting", "skeleton_solver",

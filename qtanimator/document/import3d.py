@@ -10,7 +10,8 @@ the user (companion files that were picked up, approximations). The GUI's opener
   the folder's only ``.anim`` is used; among several, the one whose name starts with the
   skeleton's stem and is a prefix of every other such name (``wasp.skel`` →
   ``wasp_walk.anim`` next to ``wasp_walk_crlf.anim``).
-* ``.skin``: replaces the skin of a character, or brings the ``.skel`` of the same stem.
+* ``.skin``: replaces the skin of a character, or brings the ``.skel`` of the same stem;
+  with neither, the skin alone in its bind pose on one root joint (a static mesh).
 * ``.anim``: replaces a character's channels (:func:`load_anim_command`).
 * ``.obj``: an MIT mesh with its ``.skel`` (required) and ``.attach`` of the same stem.
 * ``.bvh``: skeleton (a rotation order per joint) and motion as channels with linear keys.
@@ -24,6 +25,7 @@ An import that brings a clip longer than the document's frame range also lengthe
 
 from __future__ import annotations
 
+import contextlib
 import math
 import os
 from collections.abc import Sequence
@@ -47,11 +49,17 @@ from qtanimator.document.character3d import (
     clip_range_command,
     load_anim_command,
     load_bvh_character,
+    load_skin_character,
+    skin_texture,
+)
+from qtanimator.document.character3d import (
+    bounds as character3d_bounds,
 )
 from qtanimator.document.commands import AddAsset, Command, Macro, SetParameter
 from qtanimator.document.document import Asset, Document
 from qtanimator.document.gltf_character import GLTF_ROTATION_ORDER, character_from_gltf
 from qtanimator.document.gltf_export import character_scene
+from qtanimator.document.placement import CHARACTER_HEIGHT, FAR_FROM_UNIT, GAP, PLACEMENT
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.gltf import CharacterExport, export_glb, import_gltf
@@ -62,6 +70,7 @@ FloatArray = npt.NDArray[np.float64]
 
 SUFFIXES = (".skel", ".skin", ".anim", ".obj", ".bvh", ".glb", ".gltf")
 GLTF_SUFFIXES = (".glb", ".gltf")
+
 
 __all__ = [
     "GLTF_ROTATION_ORDER", "GLTF_SUFFIXES", "Import", "SUFFIXES", "anim_import", "bvh_import", "companions",
@@ -156,6 +165,54 @@ def _with_range(doc: Document, text: str, add: Command, end_time: float, asset_i
     return Import(add, asset_id, notes)
 
 
+def place_new_character(doc: Document, add: AddAsset, time: float = 0.0) -> list[str]:
+    """Give a 3D character about to be added an authored placement (issue 14): scaled
+    uniformly to the height of the 3D characters already there (their median), or to
+    :data:`~qtanimator.document.placement.CHARACTER_HEIGHT` when there are none (so a file
+    in centimetres and one in metres look the same size), standing on the floor (y = 0)
+    and, when the document has 3D characters already, beside them along +x with its box
+    clear of theirs. The scale lives in the asset's ``placement`` (the file's numbers stay as they
+    are). A character alone in the document keeps its file's place and size unless its size
+    is more than :data:`~qtanimator.document.placement.FAR_FROM_UNIT` times off (a file in
+    centimetres or millimetres): a lone import stays exactly as the file has it.
+    Returns notes for the user."""
+    scratch = Document()
+    add.do(scratch)
+    aid = add.asset.id
+    try:
+        lo, hi = character3d_bounds(scratch, aid, time)
+    except (ValueError, KeyError, np.linalg.LinAlgError):
+        return []
+    others = [a for a, asset in doc.assets.items() if asset.kind == ASSET_KIND and a in doc.runtime]
+    height = float(hi[1] - lo[1])
+    extent = float(np.max(hi - lo))
+    size = height if height > 1e-6 * max(extent, 1e-12) else extent
+    if not math.isfinite(size) or size <= 0.0:
+        return []
+    boxes = []
+    for other in others:
+        with contextlib.suppress(ValueError, KeyError, np.linalg.LinAlgError):
+            boxes.append(character3d_bounds(doc, other, time))
+    heights = [float(b[1][1] - b[0][1]) for b in boxes]
+    heights = [h for h in heights if math.isfinite(h) and h > 0.0]
+    # the common size: that of the characters already there (a lone first one may keep its
+    # file's size), else the standard height
+    common = float(np.median(heights)) if heights else CHARACTER_HEIGHT
+    scale = common / size
+    if not boxes and 1.0 / FAR_FROM_UNIT <= scale <= FAR_FROM_UNIT:
+        return []  # alone and not wildly off in size: left where (and as big as) its file puts it
+    lo_s, hi_s = lo * scale, hi * scale
+    translate = np.array([-(lo_s[0] + hi_s[0]) / 2.0, -lo_s[1], -(lo_s[2] + hi_s[2]) / 2.0])
+    if boxes:
+        right = max(float(b[1][0]) for b in boxes)
+        translate[0] = right + GAP * common - lo_s[0]
+        translate[2] = float(np.mean([(b[0][2] + b[1][2]) / 2.0 for b in boxes])) - (lo_s[2] + hi_s[2]) / 2.0
+    add.asset.properties[PLACEMENT] = {"translate": [float(v) for v in translate], "rotate": [0.0, 0.0, 0.0],
+                                       "scale": float(scale)}
+    return [f"Placed at x = {translate[0]:.3g}, scaled ×{scale:.3g} to {common:.3g} units tall "
+            "(Properties ▸ Placement)."]
+
+
 def _linear_channel(times: Sequence[float], values: Sequence[float]) -> Channel:
     keys = [Key(float(t), float(v), Tangent.LINEAR, Tangent.LINEAR, interpolation=Interpolation.LINEAR)
             for t, v in zip(times, values)]
@@ -180,6 +237,7 @@ def skel_import(doc: Document, path: str | os.PathLike[str]) -> Import:
         cmd = add_character3d_command(doc, p, found.get("skin"), None, found.get("obj"), found.get("attach"))
         notes = [f"{anim.name} does not fit {p.name} and was not loaded."]
     assert isinstance(cmd, AddAsset)
+    notes += place_new_character(doc, cmd)
     clip = cmd.runtime.clip
     return _with_range(doc, cmd.text, cmd, clip.end if clip is not None else 0.0, cmd.asset.id, notes)
 
@@ -212,17 +270,26 @@ def skin_import(doc: Document, path: str | os.PathLike[str], selected: str | Non
         notes = [f"Loaded with {skel.name}" + (f" and {anim.name}." if anim else ".")]
         clip = cmd.runtime.clip
         return _with_range(doc, cmd.text, cmd, clip.end if clip is not None else 0.0, cmd.asset.id, notes)
-    target = target or target_character(doc, None)
     if target is None:
-        raise FormatError(f"a skin needs a skeleton: select a 3D character, or put {p.stem}.skel next to "
-                          "the skin.", p)
+        # The only 3D character is dressed when it is a .skel one; anything else (a glTF,
+        # a BVH) cannot wear a .skin, so the skin opens alone.
+        only = target_character(doc, None)
+        if only is not None and Path(doc.assets[only].source or "").suffix.lower() == ".skel":
+            target = only
+    if target is None:
+        # Nothing to dress: the skin alone, as stored (its bind pose) on one still root joint.
+        runtime = load_skin_character(p)
+        aid = doc.unique_asset_id(_asset_base(p))
+        add = AddAsset(Asset(aid, ASSET_KIND, str(p.resolve()), {}), runtime, text=f"Add 3D character {aid}")
+        return Import(add, aid, [f"No {p.stem}.skel next to {p.name} and no 3D character to dress: the skin is "
+                                 "shown in its bind pose on one root joint."])
     asset = doc.assets[target]
     if not asset.source or Path(asset.source).suffix.lower() != ".skel":
         raise FormatError(f"a .skin file can only dress a character loaded from a .skel file; "
                           f"{target!r} comes from {Path(asset.source or '?').name}.", p)
     old = character(doc, target)
     skin = load_skin(p, num_joints=len(old.skeleton.joints))
-    runtime = Character3D(old.skeleton, skin, None, old.clip, False)
+    runtime = Character3D(old.skeleton, skin, None, old.clip, False, texture=skin_texture(skin, p))
     props = dict(asset.properties)
     for name in ("obj_file", "attach_file"):
         props.pop(name, None)
@@ -260,6 +327,7 @@ def bvh_import(doc: Document, path: str | os.PathLike[str]) -> Import:
     add = AddAsset(asset, runtime, channels, text=f"Add 3D character {aid}")
     n = max((len(c.keys) for c in channels.values()), default=0)
     notes = [f"{len(runtime.skeleton.joints)} joints, {n} frames.", *runtime.notes]
+    notes += place_new_character(doc, add)
     return _with_range(doc, add.text, add, _channels_end(list(channels.values())), aid, notes)
 
 
@@ -305,6 +373,7 @@ def gltf_import(doc: Document, path: str | os.PathLike[str]) -> Import:
         notes.append(f"{len(ch.clips)} clips: {listed}; pick one in Properties or in the Clip list under the "
                      "3D view.")
     notes += mapping.notes
+    notes += place_new_character(doc, add, ch.clips[0].start if ch.clips else 0.0)
     if not ch.clips:
         return Import(add, aid, notes)
     if _animated_elsewhere(doc):

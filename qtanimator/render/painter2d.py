@@ -35,6 +35,7 @@ from PySide6.QtGui import (
 from qtanimator.core.rig2d import RGBA, Character, Pose, Shape
 from qtanimator.document.character2d import character, character_assets, evaluate_pose
 from qtanimator.document.document import Document
+from qtanimator.document.outliner import is_hidden
 from qtanimator.render.svg_draw import draw_joint
 
 _PATHS: weakref.WeakKeyDictionary[Character, list[list[QPainterPath]]] = weakref.WeakKeyDictionary()
@@ -192,7 +193,12 @@ def _poses_bounds(doc: Document, poses: dict[str, Pose]) -> QRectF:
 
 def scene_bounds(doc: Document, time: float) -> QRectF:
     """The bounding box of every 2D character posed at ``time`` (empty rect if none)."""
-    return _poses_bounds(doc, {aid: evaluate_pose(doc, aid, time) for aid in character_assets(doc)})
+    return _poses_bounds(doc, {aid: evaluate_pose(doc, aid, time) for aid in visible_characters(doc)})
+
+
+def visible_characters(doc: Document) -> list[str]:
+    """The 2D characters that are drawn (the outliner hides the others)."""
+    return [aid for aid in character_assets(doc) if not is_hidden(doc, aid)]
 
 
 def animation_bounds(doc: Document, times: Iterable[float]) -> QRectF:
@@ -236,7 +242,7 @@ def render_frame(doc: Document, time: float, size: tuple[int, int] = (960, 640),
         raise ValueError("the image size must be positive")
     image = QImage(w, h, QImage.Format.Format_ARGB32_Premultiplied)
     image.fill(background_color(background))
-    ids = list(assets) if assets is not None else character_assets(doc)
+    ids = list(assets) if assets is not None else visible_characters(doc)
     poses = {aid: evaluate_pose(doc, aid, time) for aid in ids}
     if view is None:
         view = _poses_bounds(doc, poses)

@@ -39,6 +39,8 @@ def scene_items(doc: Any, time: float, selection: tuple[str, str] = ("", ""),
     """
     items: list[SceneItem] = []
     for asset_id, asset in doc.assets.items():
+        if asset.properties.get("hidden"):
+            continue  # hidden in the outliner (document.outliner)
         try:
             if asset.kind == CHARACTER_KIND:
                 item = character_item(doc, asset_id, time, selection)
@@ -113,13 +115,66 @@ def skin_draw(doc: Any, asset_id: str, world: np.ndarray) -> SkinDraw | None:
     n = min(len(world), len(inv))
     matrices = np.tile(np.eye(4), (len(inv), 1, 1))
     matrices[:n] = world[:n] @ inv[:n]
-    parts = part_colors(runtime, len(arrays["triangles"])) if isinstance(runtime, character3d.Character3D) else ()
+    is_character = isinstance(runtime, character3d.Character3D)
+    parts = part_colors(runtime, len(arrays["triangles"])) if is_character else ()
+    textures = texture_ranges(runtime, len(arrays["triangles"])) if is_character else ()
+    texcoords = gpu_texcoords(skin, runtime) if textures else None
     return SkinDraw(key=skin, positions=arrays["positions"], normals=arrays["normals"],
                     triangles=arrays["triangles"], influence=arrays["influence"], pairs=arrays["pairs"],
-                    matrices=matrices, faceted=faceted, parts=parts)
+                    matrices=matrices, faceted=faceted, parts=parts, texcoords=texcoords,
+                    textures=textures if texcoords is not None else ())
+
+
+def texture_ranges(runtime: character3d.Character3D, triangles: int) -> tuple[tuple[int, int, Color, Any], ...]:
+    """(first triangle, count, base colour, image or None) covering the skin when a part (or,
+    for a skin without parts, the character) has an image; empty otherwise. A textured part's
+    base colour is its material's (white for a course skin's texture); untextured ranges keep
+    the colours :func:`part_colors` gives them."""
+    if not runtime.parts:
+        return ((0, triangles, WHITE, runtime.texture),) if runtime.texture is not None and triangles else ()
+    if not any(p.texture is not None for p in runtime.parts):
+        return ()
+    coloured = part_colors(runtime, triangles) or ((0, triangles, SKIN_COLOR),)
+    images = sorted(((p.triangle_start, p.triangle_count, display_color(p.color), p.texture)
+                     for p in runtime.parts if p.texture is not None and p.triangle_count > 0),
+                    key=lambda r: r[0])
+    out: list[tuple[int, int, Color, Any]] = []
+    for first, count, colour in coloured:
+        at, end = first, first + count
+        for t_first, t_count, t_colour, image in images:
+            lo, hi = max(at, t_first), min(end, t_first + t_count)
+            if hi <= lo:
+                continue
+            if lo > at:
+                out.append((at, lo - at, colour, None))
+            out.append((lo, hi - lo, t_colour, image))
+            at = hi
+        if at < end:
+            out.append((at, end - at, colour, None))
+    return tuple(out)
+
+
+def gpu_texcoords(skin: Any, runtime: Any) -> np.ndarray | None:
+    """(N, 2) float32 texture coordinates with t = 0 at the image's top row (glTF's v as it
+    is; a course skin's v, whose origin is the bottom left, flipped), cached in the skin's extras."""
+    extras = getattr(skin, "extras", None)
+    cached = extras.get("_gpu_texcoords") if isinstance(extras, dict) else None
+    if cached is not None:
+        return cached  # type: ignore[no-any-return]
+    uv = getattr(skin, "texcoords", None)
+    if uv is None or np.shape(uv)[1] < 2:
+        return None
+    out = np.asarray(uv, dtype=np.float32)[:, :2].copy()
+    if getattr(runtime.skeleton, "dialect", "") != "gltf":
+        out[:, 1] = 1.0 - out[:, 1]
+    if isinstance(extras, dict):
+        extras["_gpu_texcoords"] = out
+    return out
 
 
 Color = tuple[float, float, float, float]
+#: the base colour of a course skin's texture (the image as it is)
+WHITE: Color = (1.0, 1.0, 1.0, 1.0)
 
 
 def display_color(linear: Sequence[float]) -> Color:

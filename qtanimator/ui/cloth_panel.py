@@ -108,8 +108,9 @@ class ClothPanel(QWidget):
         self.pause.setObjectName("clothPause")
         self.pause.setCheckable(True)
         self.pause.toggled.connect(self._on_pause)
-        self.reset = QPushButton("Reset", self)
+        self.reset = QPushButton("Reset cloth", self)
         self.reset.setObjectName("clothReset")
+        self.reset.setToolTip("Put the interactive cloth back in its rest shape (Shift+R in the 3D view)")
         self.reset.clicked.connect(self._on_reset)
         for w in (self.live, self.pause, self.reset):
             sim.addWidget(w)
@@ -118,6 +119,14 @@ class ClothPanel(QWidget):
         self.message.setObjectName("clothMessage")
         self.message.setWordWrap(True)
         outer.addWidget(self.message)
+        # Why a simulation stopped (a blow-up), naming the parameter to change.
+        self.problem = QLabel(self)
+        self.problem.setObjectName("clothProblem")
+        self.problem.setWordWrap(True)
+        self.problem.setStyleSheet("color: #c0392b;")
+        self.problem.hide()
+        outer.addWidget(self.problem)
+        self._last_problem = ""
         # Without numba the solver runs on numpy, several times slower: say so once, here.
         from qtanimator.core import cloth_kernels
 
@@ -399,9 +408,10 @@ class ClothPanel(QWidget):
         """Show how far the cloth cache worker is (a list of ClothProgress)."""
         lines: list[str] = []
         running = cancelled = False
+        self.show_problems(progress)
         for p in progress:
             if p.error:
-                lines.append(f"{p.asset_id}: {p.error}")
+                continue   # shown by show_problems
             elif p.running and p.elapsed >= self.PROGRESS_AFTER_S:
                 running = True
                 lines.append(f"Simulating {p.asset_id}: {p.done} of {p.wanted} frames "
@@ -413,6 +423,28 @@ class ClothPanel(QWidget):
         self.progress.setVisible(bool(lines))
         self.cancel.setText("Cancel" if running else "Resume")
         self.cancel.setVisible(running or cancelled)
+
+    def show_problems(self, progress: list[Any] | None = None) -> str:
+        """Show why a cloth stopped (cache or interactive blow-ups) in the dock's
+        ``clothProblem`` label and the status bar; the text names the parameter to change."""
+        vp = self._viewport()
+        if progress is None:
+            worker = getattr(vp, "cloth_worker", None)
+            progress = worker.progress() if worker is not None else []
+        lines = [f"Cloth '{p.asset_id}' stopped: {p.error}" for p in progress if p.error]
+        live = getattr(vp, "live", None)
+        for aid, text in sorted(getattr(live, "errors", {}).items()):
+            lines.append(f"Interactive cloth '{aid}' stopped: {text}")
+        text = "\n".join(lines)
+        self.problem.setText(text)
+        self.problem.setVisible(bool(text))
+        if text and text != self._last_problem:
+            bar = getattr(self.window_, "statusBar", None)
+            if callable(bar):
+                # the same words as the timeline's cache bar uses for a simulation that stopped
+                bar().showMessage("Simulation stopped: " + lines[0], 15000)
+        self._last_problem = text
+        return text
 
     def _on_cancel(self) -> None:
         vp = self._viewport()
@@ -443,8 +475,8 @@ class ClothPanel(QWidget):
     def _on_reset(self) -> None:
         vp = self._viewport()
         if vp is not None:
-            vp.live.reset()
-            vp.update()
+            vp.reset_cloth()
+        self.show_problems()
 
 
 def install(window: Any) -> None:

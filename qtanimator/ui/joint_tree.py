@@ -23,26 +23,33 @@ from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from PySide6.QtCore import QPoint, QPointF, Qt
+from PySide6.QtCore import QEvent, QPoint, QPointF, Qt, QTimer
 from PySide6.QtGui import (
     QAction,
     QBrush,
     QColor,
+    QContextMenuEvent,
     QIcon,
     QKeyEvent,
     QKeySequence,
     QMouseEvent,
     QPainter,
+    QPainterPath,
+    QPalette,
     QPen,
     QPixmap,
     QPolygonF,
 )
 from PySide6.QtWidgets import (
+    QAbstractItemView,
     QApplication,
+    QDockWidget,
     QDoubleSpinBox,
     QGridLayout,
     QHBoxLayout,
+    QHeaderView,
     QLabel,
+    QMenu,
     QPushButton,
     QSlider,
     QTreeWidget,
@@ -51,9 +58,11 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from qtanimator.document.commands import Command, Macro
+from qtanimator.document import outliner
+from qtanimator.document.commands import Command, Macro, RemoveAsset
 from qtanimator.document.document import Document, DocumentChange, split_channel_id
 from qtanimator.document.gesture import Gesture
+from qtanimator.document.outliner import HIDDEN, LOCKED
 from qtanimator.document.pose import PosePreview, autokey
 from qtanimator.ui.context import EditorContext
 
@@ -61,6 +70,13 @@ if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
 
 ROLE = Qt.ItemDataRole.UserRole
+#: What a row is: "asset", "joint" or "light".
+KIND_ROLE = Qt.ItemDataRole.UserRole + 1
+NAME_COLUMN, EYE_COLUMN, LOCK_COLUMN = 0, 1, 2
+TOGGLE_WIDTH = 24
+#: Light rows carry ``light:NAME`` as their id (a light is no asset; no asset id holds ':').
+LIGHT_PREFIX = "light:"
+LIGHT_TITLES = {"light1": "Light 1 (key)", "light2": "Light 2 (fill)"}
 SLIDER_STEPS_PER_UNIT = 10  # 0.1° (or 0.1 unit) per slider step
 TRANSLATION_LIMIT = 5000.0
 
@@ -321,6 +337,47 @@ def _icon(kind: str) -> QIcon:
         p.setPen(QPen(QColor(150, 80, 0), 1.2))
         p.setBrush(QBrush(QColor(255, 160, 0)) if kind == "keyed" else Qt.BrushStyle.NoBrush)
         p.drawPolygon(diamond)
+    elif kind in ("shown", "hidden"):
+        eye = QPainterPath()
+        eye.moveTo(1, 8)
+        eye.quadTo(8, 1, 15, 8)
+        eye.quadTo(8, 15, 1, 8)
+        p.setPen(QPen(QColor(40, 40, 40) if kind == "shown" else QColor(160, 160, 160), 1.3))
+        p.setBrush(QBrush(QColor(255, 255, 255)) if kind == "shown" else Qt.BrushStyle.NoBrush)
+        p.drawPath(eye)
+        if kind == "shown":
+            p.setBrush(QBrush(QColor(40, 40, 40)))
+            p.drawEllipse(QPointF(8, 8), 2.5, 2.5)
+        else:
+            p.drawLine(QPointF(2, 14), QPointF(14, 2))
+    elif kind in ("locked", "unlocked"):
+        color = QColor(40, 40, 40) if kind == "locked" else QColor(175, 175, 175)
+        p.setPen(QPen(color, 1.5))
+        p.setBrush(Qt.BrushStyle.NoBrush)
+        shackle = QPainterPath()
+        shackle.moveTo(5, 8)
+        shackle.lineTo(5, 5)
+        shackle.arcTo(5, 2, 6, 6, 180, -180)
+        shackle.lineTo(11, 8 if kind == "locked" else 5)
+        p.drawPath(shackle)
+        p.setBrush(QBrush(color))
+        p.drawRoundedRect(3, 8, 10, 7, 1.5, 1.5)
+    elif kind == "cloth":
+        p.setPen(QPen(QColor(60, 60, 90), 1.0))
+        p.setBrush(QBrush(QColor(200, 120, 200)))
+        cloth = QPainterPath()
+        cloth.moveTo(2, 3)
+        cloth.lineTo(14, 3)
+        cloth.quadTo(12, 9, 14, 14)
+        cloth.quadTo(8, 11, 2, 14)
+        cloth.quadTo(4, 9, 2, 3)
+        p.drawPath(cloth)
+    elif kind == "light":
+        p.setPen(QPen(QColor(150, 110, 0), 1.0))
+        p.setBrush(QBrush(QColor(255, 220, 90)))
+        p.drawEllipse(QPointF(8, 7), 4.5, 4.5)
+        p.setBrush(QBrush(QColor(120, 120, 120)))
+        p.drawRect(6, 12, 4, 3)
     elif kind == "character":
         p.setPen(QPen(QColor(30, 30, 30), 1.2))
         p.setBrush(QBrush(QColor(120, 170, 255)))
@@ -501,30 +558,79 @@ class DofPanel(QWidget):
 
 
 class JointTree(QTreeWidget):
-    """Assets and their joint hierarchies."""
+    """The outliner: every asset (2D and 3D characters with their joints, cloths, others)
+    and the two lights, each with an eye (shown / hidden) and a lock toggle.
+
+    Click the eye or the lock to toggle it; F2 or a double-click renames an asset, Delete
+    removes it, and the right-click menu frames it in the view, resets its pose, hides,
+    locks, renames or removes it. Every change is one undo step."""
 
     def __init__(self, ctx: EditorContext, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("jointTree")
         self.ctx = ctx
         self.setHeaderHidden(True)
-        self.setColumnCount(1)
-        self.icons = {k: _icon(k) for k in ("dynamic", "keyed", "key", "character", "skeleton")}
+        self.setColumnCount(3)
+        header = self.header()
+        header.setStretchLastSection(False)
+        header.setSectionResizeMode(NAME_COLUMN, QHeaderView.ResizeMode.Stretch)
+        for column in (EYE_COLUMN, LOCK_COLUMN):
+            header.setSectionResizeMode(column, QHeaderView.ResizeMode.Fixed)
+            header.resizeSection(column, TOGGLE_WIDTH)
+        self.setEditTriggers(QAbstractItemView.EditTrigger.NoEditTriggers)  # F2 / double-click: below
+        self.icons = {k: _icon(k) for k in ("dynamic", "keyed", "key", "character", "skeleton", "cloth", "light",
+                                            "shown", "hidden", "locked", "unlocked")}
         self._items: dict[tuple[str, str], QTreeWidgetItem] = {}
         self._syncing = False
         self.currentItemChanged.connect(self._current_changed)
+        self.itemChanged.connect(self._item_changed)
         #: A re-parenting drag: the joint item pressed, where, and whether it is moving.
         self._press: tuple[QTreeWidgetItem, QPoint] | None = None
         self.reparenting = False
         self.last_message = ""
+        #: The open context menu (tests find its actions here).
+        self.menu: QMenu | None = None
 
-    # ------------------------------------------------------- drag to re-parent
+    # ------------------------------------------------------------- rows
+    @staticmethod
+    def row_kind(item: QTreeWidgetItem | None) -> str:
+        """``asset``, ``joint`` or ``light`` (``""`` for None)."""
+        return "" if item is None else str(item.data(0, KIND_ROLE))
+
+    def light_item(self, name: str) -> QTreeWidgetItem | None:
+        return self._items.get((LIGHT_PREFIX + name, ""))
+
+    def toggle_rect(self, item: QTreeWidgetItem, column: int) -> Any:
+        """Where the eye (EYE_COLUMN) or lock (LOCK_COLUMN) of a row is drawn (viewport coordinates)."""
+        return self.visualRect(self.indexFromItem(item, column))
+
+    # ------------------------------------------------------- mouse and keys
+    def _toggle_at(self, event: QMouseEvent) -> bool:
+        """A left press on an eye or a lock: toggle it (without selecting the row)."""
+        if event.button() != Qt.MouseButton.LeftButton:
+            return False
+        pos = event.position().toPoint()
+        item = self.itemAt(pos)
+        column = self.columnAt(pos.x())
+        if item is None or column not in (EYE_COLUMN, LOCK_COLUMN) or self.row_kind(item) == "joint":
+            return False
+        self.toggle(item.data(0, ROLE)[0], HIDDEN if column == EYE_COLUMN else LOCKED)
+        event.accept()
+        return True
+
     def mousePressEvent(self, event: QMouseEvent) -> None:
-        super().mousePressEvent(event)
-        item = self.itemAt(event.position().toPoint())
         self._press = None
         self.reparenting = False
-        if event.button() == Qt.MouseButton.LeftButton and item is not None and item.data(0, ROLE)[1]:
+        if self._toggle_at(event):
+            return
+        super().mousePressEvent(event)
+        item = self.itemAt(event.position().toPoint())
+        if event.button() == Qt.MouseButton.RightButton:
+            self._menu_requested(event.position().toPoint())
+            event.accept()
+            return
+        if event.button() == Qt.MouseButton.LeftButton and self.row_kind(item) == "joint":
+            assert item is not None
             self._press = (item, event.position().toPoint())
 
     def mouseMoveEvent(self, event: QMouseEvent) -> None:
@@ -553,6 +659,170 @@ class JointTree(QTreeWidget):
         if target is None or target is press[0]:
             return
         self.reparent(press[0].data(0, ROLE), target.data(0, ROLE))
+
+    def mouseDoubleClickEvent(self, event: QMouseEvent) -> None:
+        if self._toggle_at(event):  # a quick second click on a toggle toggles it back
+            return
+        item = self.itemAt(event.position().toPoint())
+        if event.button() == Qt.MouseButton.LeftButton and self.row_kind(item) == "asset":
+            assert item is not None
+            self.start_rename(item)
+            event.accept()
+            return
+        super().mouseDoubleClickEvent(event)
+
+    def event(self, event: QEvent) -> bool:
+        # F2 and Delete belong to the tree while it has the focus (not to a window shortcut).
+        if event.type() == QEvent.Type.ShortcutOverride and isinstance(event, QKeyEvent) \
+                and event.key() in (Qt.Key.Key_F2, Qt.Key.Key_Delete) and self.state() != self.State.EditingState:
+            event.accept()
+            return True
+        return super().event(event)
+
+    def keyPressEvent(self, event: QKeyEvent) -> None:
+        item = self.currentItem()
+        if self.state() != self.State.EditingState and event.modifiers() == Qt.KeyboardModifier.NoModifier:
+            if event.key() == Qt.Key.Key_F2 and item is not None:
+                self.start_rename(item)
+                event.accept()
+                return
+            if event.key() in (Qt.Key.Key_Delete, Qt.Key.Key_Backspace) and item is not None:
+                self.remove(item.data(0, ROLE)[0] if self.row_kind(item) != "joint" else "")
+                event.accept()
+                return
+        super().keyPressEvent(event)
+
+    # ------------------------------------------------------------- edits
+    def toggle(self, target: str, name: str) -> None:
+        """Flip ``hidden`` or ``locked`` of an asset (or ``light:NAME`` row id): one undo step."""
+        target = target.removeprefix(LIGHT_PREFIX)
+        self.ctx.push(outliner.set_flag_command(self.ctx.doc, target, name, not outliner.flag(self.ctx.doc,
+                                                                                                target, name)))
+
+    def start_rename(self, item: QTreeWidgetItem) -> bool:
+        if self.row_kind(item) != "asset":
+            return self._say("Only assets can be renamed here.")
+        self.setCurrentItem(item, NAME_COLUMN)
+        self.editItem(item, NAME_COLUMN)
+        return True
+
+    def _item_changed(self, item: QTreeWidgetItem, column: int) -> None:
+        if self._syncing or column != NAME_COLUMN or self.row_kind(item) != "asset":
+            return
+        old = item.data(0, ROLE)[0]
+        new = item.text(NAME_COLUMN).strip()
+        if new == old:
+            return
+        # The tree is rebuilt by the rename: leave the editor's signal first.
+        QTimer.singleShot(0, lambda: self.rename(old, new))
+
+    def rename(self, old: str, new: str) -> bool:
+        """Rename an asset (its channels and the selection follow); a name in use, empty or
+        with other characters than letters, digits and - _ . is refused with a message."""
+        doc = self.ctx.doc
+        problem = outliner.name_problem(doc, old, new)
+        if problem is not None:
+            item = self._items.get((old, ""))
+            if item is not None:
+                self._syncing = True
+                item.setText(NAME_COLUMN, old)
+                self._syncing = False
+            return self._say(problem)
+        asset, joint = self.ctx.selection
+        channels = self.ctx.channel_selection
+        self.ctx.push(outliner.rename_command(doc, old, new))
+        if asset == old:
+            self.ctx.select(new, joint)
+        prefix = old + "/"
+        if any(c.startswith(prefix) for c in channels):
+            self.ctx.select_channels([new + "/" + c[len(prefix):] if c.startswith(prefix) else c for c in channels])
+        self._say(f"Renamed {old} to {new}.")
+        return True
+
+    def remove(self, asset: str) -> bool:
+        """Remove an asset and its channels: one undo step."""
+        if asset.startswith(LIGHT_PREFIX):
+            return self._say("The lights cannot be removed: hide them instead.")
+        if asset not in self.ctx.doc.assets:
+            return self._say("Select an asset's row to remove it.")
+        self.ctx.push(RemoveAsset(self.ctx.doc, asset))
+        return True
+
+    # ------------------------------------------------------- context menu
+    def contextMenuEvent(self, event: QContextMenuEvent) -> None:
+        # A right press opens the menu (mousePressEvent); here only the Menu key does.
+        event.accept()
+        if event.reason() != QContextMenuEvent.Reason.Mouse and self.currentItem() is not None:
+            self._menu_requested(self.visualItemRect(self.currentItem()).center())
+
+    def _menu_requested(self, pos: QPoint) -> None:
+        item = self.itemAt(pos)
+        if item is None:
+            return
+        menu = self.context_menu(item)
+        menu.popup(self.viewport().mapToGlobal(pos))
+
+    def context_menu(self, item: QTreeWidgetItem) -> QMenu:
+        """The right-click menu of a row (of its asset for a joint's row)."""
+        target = item.data(0, ROLE)[0]
+        light = self.row_kind(item) == "light"
+        name = target.removeprefix(LIGHT_PREFIX)
+        doc = self.ctx.doc
+        menu = QMenu(self)
+        menu.setObjectName("outlinerMenu")
+        menu.setAttribute(Qt.WidgetAttribute.WA_DeleteOnClose)
+
+        def add(object_name: str, text: str, slot: Callable[[], object], enabled: bool = True) -> QAction:
+            action = menu.addAction(text)
+            action.setObjectName(object_name)
+            action.setEnabled(enabled)
+            action.triggered.connect(lambda _c=False: slot())
+            return action
+
+        m2, m3 = c2d(), c3d()
+        kind = _asset_kind(doc, target)
+        character = kind in {m.ASSET_KIND for m in (m2, m3) if m is not None}
+        add("outlinerFrame", "Frame in View", lambda: self.frame_in_view(target), not light)
+        add("outlinerResetPose", "Reset Pose", lambda: self._reset_pose(target), character)
+        menu.addSeparator()
+        hidden, locked = outliner.is_hidden(doc, name), outliner.is_locked(doc, name)
+        add("outlinerHide", "Show" if hidden else "Hide", lambda: self.toggle(name, HIDDEN))
+        add("outlinerLock", "Unlock" if locked else "Lock", lambda: self.toggle(name, LOCKED))
+        menu.addSeparator()
+        rename_item = self._items.get((target, ""))
+        add("outlinerRename", "Rename… (F2)", lambda: rename_item is not None and self.start_rename(rename_item),
+            not light)
+        add("outlinerRemove", "Remove (Delete)", lambda: self.remove(target), not light)
+        self.menu = menu
+        return menu
+
+    def _reset_pose(self, asset: str) -> None:
+        cmd = reset_pose_command(self.ctx.doc, asset, self.ctx.time)
+        if cmd is not None:
+            self.ctx.push(cmd)
+
+    def frame_in_view(self, asset: str) -> bool:
+        """Show the editor that draws ``asset`` and fit its view to it: the 2D editor for a
+        2D character, the 3D view for the rest."""
+        window = self.window()
+        m2 = c2d()
+        doc = self.ctx.doc
+        if asset not in doc.assets:
+            return False
+        if m2 is not None and _asset_kind(doc, asset) == m2.ASSET_KIND:
+            editor = getattr(window, "rig_editor", None)
+            if editor is None:
+                return False
+            _show_central(window, editor)
+            return bool(editor.view.frame_asset(asset))
+        view = getattr(window, "viewport3d", None)
+        if view is None:
+            return False
+        _show_central(window, getattr(window, "viewport_panel", view))
+        if self.ctx.selection[0] != asset:
+            self.ctx.select(asset, "")
+        view.frame_selection()
+        return True
 
     def reparent(self, source: tuple[str, str], target: tuple[str, str]) -> bool:
         """Make ``target`` (asset, joint) the parent of ``source``: one undo step."""
@@ -588,29 +858,64 @@ class JointTree(QTreeWidget):
         self._items.clear()
         doc = self.ctx.doc
         m2, m3 = c2d(), c3d()
-        kinds = {m.ASSET_KIND for m in (m2, m3) if m is not None}
         for aid, asset in doc.assets.items():
-            if asset.kind not in kinds:
-                continue
             top = QTreeWidgetItem([aid])
             top.setData(0, ROLE, (aid, ""))
-            top.setIcon(0, self.icons["character" if m2 is not None and asset.kind == m2.ASSET_KIND
-                                      else "skeleton"])
+            top.setData(0, KIND_ROLE, "asset")
+            top.setFlags(top.flags() | Qt.ItemFlag.ItemIsEditable)
+            icon = ("character" if m2 is not None and asset.kind == m2.ASSET_KIND
+                    else "skeleton" if m3 is not None and asset.kind == m3.ASSET_KIND
+                    else "cloth" if asset.kind == "cloth" else "")
+            if icon:
+                top.setIcon(0, self.icons[icon])
+            top.setToolTip(0, f"{aid} ({asset.kind}): F2 renames, Delete removes, right-click for more")
             self.addTopLevelItem(top)
             self._items[(aid, "")] = top
+            self._show_flags(top, aid)
             items: list[QTreeWidgetItem] = []
             for name, parent, _dynamic in joint_names(doc, aid):
                 item = QTreeWidgetItem([name])
                 item.setData(0, ROLE, (aid, name))
+                item.setData(0, KIND_ROLE, "joint")
                 (items[parent] if parent is not None else top).addChild(item)
                 items.append(item)
                 self._items[(aid, name)] = item
             top.setExpanded(True)
             for item in items:
                 item.setExpanded(True)
+        for name in outliner.LIGHTS:
+            row = QTreeWidgetItem([LIGHT_TITLES.get(name, name)])
+            row.setData(0, ROLE, (LIGHT_PREFIX + name, ""))
+            row.setData(0, KIND_ROLE, "light")
+            row.setIcon(0, self.icons["light"])
+            row.setToolTip(0, f"{name}: its position, colour and intensity are in the Lights dock")
+            self.addTopLevelItem(row)
+            self._items[(LIGHT_PREFIX + name, "")] = row
+            self._show_flags(row, name)
         self.refresh_icons()
         self._syncing = False
         self.follow_selection()
+
+    def _show_flags(self, item: QTreeWidgetItem, target: str) -> None:
+        """The eye and lock of a row, and its name greyed when hidden."""
+        doc = self.ctx.doc
+        hidden, locked = outliner.is_hidden(doc, target), outliner.is_locked(doc, target)
+        item.setIcon(EYE_COLUMN, self.icons["hidden" if hidden else "shown"])
+        item.setToolTip(EYE_COLUMN, "hidden: click to show" if hidden else "shown: click to hide")
+        item.setIcon(LOCK_COLUMN, self.icons["locked" if locked else "unlocked"])
+        item.setToolTip(LOCK_COLUMN, "locked: click to unlock" if locked else "click to lock (no picking in views)")
+        item.setForeground(NAME_COLUMN, self.palette().brush(
+            QPalette.ColorGroup.Disabled if hidden else QPalette.ColorGroup.Active, QPalette.ColorRole.Text))
+
+    def refresh_flags(self) -> None:
+        """Update every row's eye and lock (flags are asset properties and light parameters)."""
+        self._syncing = True
+        try:
+            for (target, joint), item in self._items.items():
+                if not joint:
+                    self._show_flags(item, target.removeprefix(LIGHT_PREFIX))
+        finally:
+            self._syncing = False
 
     def refresh_icons(self, assets: Collection[str] | None = None) -> None:
         """Update the keyed / not keyed icons of every joint (of ``assets`` only if given)."""
@@ -652,6 +957,13 @@ class JointTree(QTreeWidget):
         if self._syncing or current is None:
             return
         asset, joint = current.data(0, ROLE)
+        if self.row_kind(current) == "light":
+            # A light is no asset: show its dock (position, colour, intensity) instead.
+            dock = self.window().findChild(QDockWidget, "lightDock")
+            if dock is not None:
+                dock.show()
+                dock.raise_()
+            return
         self.ctx.select(asset, joint)
 
     def step_joint(self, delta: int) -> None:
@@ -699,6 +1011,8 @@ class JointTreePanel(QWidget):
             return
         if change.channels:
             self.tree.refresh_icons(change.channel_assets())
+        if any(p.endswith((".hidden", ".locked")) for p in change.parameters):
+            self.tree.refresh_flags()  # a light's eye or lock
         if change.channels or change.parameters:
             self.dofs.refresh_values()
 
@@ -711,10 +1025,22 @@ class JointTreePanel(QWidget):
             self.ctx.push(cmd)
 
 
+def _show_central(window: QWidget, widget: QWidget) -> None:
+    """Bring the central tab holding ``widget`` to the front."""
+    tabs = getattr(window, "central_tabs", None)
+    if tabs is None:
+        return
+    for i in range(tabs.count()):
+        page = tabs.widget(i)
+        if page is widget or page.isAncestorOf(widget):
+            tabs.setCurrentIndex(i)
+            return
+
+
 def install(window: MainWindow) -> None:
     panel = JointTreePanel(window.ctx)
     window.joint_tree = panel  # type: ignore[attr-defined]
-    window.add_dock("jointTreeDock", "Joints", panel, Qt.DockWidgetArea.LeftDockWidgetArea)
+    window.add_dock("jointTreeDock", "Outliner", panel, Qt.DockWidgetArea.LeftDockWidgetArea)
     reset = QAction("Reset Pose", window)
     reset.setObjectName("actionResetPose")
     reset.setShortcut(QKeySequence("R"))

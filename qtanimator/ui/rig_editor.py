@@ -211,8 +211,8 @@ class CharacterItem(QGraphicsItem):
         doc = self.editor.ctx.doc
         character = doc.runtime.get(self.asset)
         pose = self.editor.poses().get(self.asset)
-        if character is None or pose is None:
-            return
+        if character is None or pose is None or doc.assets[self.asset].properties.get("hidden"):
+            return  # hidden in the outliner
         highlight = self.editor.selected_joint_index(self.asset)
         hover = self.editor.hover[1] if self.editor.hover and self.editor.hover[0] == self.asset else None
         if self.editor.use_sprites():
@@ -381,6 +381,19 @@ class RigEditorView(QGraphicsView):
         self._fitted = True
         self._auto_fit = True  # follow window resizes until the user zooms or pans
         self.viewport().update()
+
+    def frame_asset(self, asset: str) -> bool:
+        """Fit the view to one character as posed now (the outliner's Frame in View)."""
+        pose = self.poses().get(asset)
+        if pose is None:
+            return False
+        x0, y0, x1, y1 = self.ctx.doc.runtime[asset].bounds(pose)
+        rect = QRectF(x0, y0, max(x1 - x0, 1e-6), max(y1 - y0, 1e-6))
+        margin = 0.05 * max(rect.width(), rect.height())
+        self.fitInView(rect.adjusted(-margin, -margin, margin, margin), Qt.AspectRatioMode.KeepAspectRatio)
+        self._auto_fit = False  # the user chose this view: keep it on resize
+        self.viewport().update()
+        return True
 
     def to_scene(self, pos: QPointF) -> np.ndarray:
         inverse, _ok = self.viewportTransform().inverted()

@@ -23,6 +23,7 @@ from qtanimator.document import character2d as c2d
 from qtanimator.document import pose
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, channel_id
+from qtanimator.document.outliner import pickable
 
 FloatArray = npt.NDArray[np.float64]
 Drag = Generator["Command | None", Any, None]
@@ -43,6 +44,8 @@ def pick(doc: Document, time: float, point: Sequence[float],
     """The topmost (character, joint index) under ``point``, or None. Picks what the editor
     shows: pendulums at their latest simulated state (nothing is simulated here)."""
     for aid in reversed(character_ids(doc)):
+        if not pickable(doc, aid):
+            continue  # hidden or locked in the outliner
         character = doc.runtime[aid]
         pose = c2d.evaluate_pose(doc, aid, time, block=False)
         j = character.hit_test(pose, np.asarray(point, dtype=np.float64), tolerance)
@@ -109,7 +112,7 @@ def move_drag(doc: Document, asset: str, press: Sequence[float], time: float, au
     p0 = np.asarray(press, dtype=np.float64)
     cursor = yield None
     while True:
-        xy = start + (np.asarray(cursor, dtype=np.float64) - p0)
+        xy = start + c2d.to_character_frame(doc, asset, np.asarray(cursor, dtype=np.float64) - p0, vector=True)
         cursor = yield pose_edit(doc, c2d.position_values(asset, xy), time, f"Move {asset}", autokey)
 
 
@@ -356,7 +359,8 @@ def rig_poses(doc: Document, time: float) -> dict[str, Any]:
     out = {}
     for aid in character_ids(doc):
         ch = doc.runtime[aid]
-        out[aid] = ch.pose(np.zeros(len(ch.joints)), c2d.translation(doc, aid, time))
+        out[aid] = ch.pose(np.zeros(len(ch.joints)), c2d.translation(doc, aid, time)).placed(
+            c2d.placement_matrix(doc, aid))
     return out
 
 
@@ -365,6 +369,8 @@ def pick_rest(doc: Document, time: float, point: Sequence[float],
     """The topmost (character, joint) under ``point`` in the setup pose (rig mode)."""
     poses = rig_poses(doc, time)
     for aid in reversed(character_ids(doc)):
+        if not pickable(doc, aid):
+            continue
         j = doc.runtime[aid].hit_test(poses[aid], np.asarray(point, dtype=np.float64), tolerance)
         if j is not None:
             return aid, int(j)

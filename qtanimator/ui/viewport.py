@@ -7,10 +7,13 @@ playback controls.
 
 Mouse: left click picks a joint (``ctx.select``); left drag orbits (on a live cloth it grabs
 the cloth, on a light's sphere it moves the light); middle drag or Shift+left pans; wheel or
-Ctrl+left zooms; right drag on a joint solves IK on its chain (one undo step, keyed at the
-current frame); right drag elsewhere zooms. Keys: F frames the selection (or everything),
+Ctrl+left zooms; right drag on a skin moves the point under the cursor by IK (that point in
+the frame of the joint influencing it most; on a joint's sphere or bone, with the skin hidden
+or missed, the joint's pivot), one undo step, keyed at the current frame; right drag elsewhere
+zooms. Keys: F frames the selection (or everything),
 X shows the axes (the MIT viewer's ``a``), B the skeleton (its ``s``), W/A/S/D/Q/E move a live
-cloth's pins, Z/C rotate them, P pauses the live cloth, R resets it, Escape cancels an IK or
+cloth's pins (CSE169: W/S in y, A/D in x, Q/E in z), Z/C rotate them, P pauses the live cloth,
+Shift+R resets it, R resets the selected character's pose, Escape cancels an IK or
 light drag. View ▸ 3D Camera… shows the camera's distance, azimuth and inclination as fields
 (:mod:`qtanimator.ui.camera_fields`); the toolbar's *Shadow* draws the floor shadow.
 
@@ -49,6 +52,7 @@ from PySide6.QtWidgets import (
 
 from qtanimator.document.cloth_worker import LiveCloths, cloth_worker
 from qtanimator.document.document import DocumentChange
+from qtanimator.document.outliner import is_locked, pickable
 from qtanimator.render.gl import surface_format, view_samples
 from qtanimator.render.gl.camera import OrbitCamera
 from qtanimator.render.gl.lights import LIGHT_NAMES, ambient_of, lights_of
@@ -71,9 +75,10 @@ from qtanimator.ui.context import EditorContext
 PIN_STEP = 0.05
 PIN_TURN = math.radians(5.0)
 PIN_KEYS = {
-    Qt.Key.Key_W: (0.0, 0.0, -PIN_STEP), Qt.Key.Key_S: (0.0, 0.0, PIN_STEP),
+    # As the CSE169 cloth project: W/S up/down (y), A/D left/right (x), Q/E in/out (z).
+    Qt.Key.Key_W: (0.0, PIN_STEP, 0.0), Qt.Key.Key_S: (0.0, -PIN_STEP, 0.0),
     Qt.Key.Key_A: (-PIN_STEP, 0.0, 0.0), Qt.Key.Key_D: (PIN_STEP, 0.0, 0.0),
-    Qt.Key.Key_Q: (0.0, PIN_STEP, 0.0), Qt.Key.Key_E: (0.0, -PIN_STEP, 0.0),
+    Qt.Key.Key_Q: (0.0, 0.0, -PIN_STEP), Qt.Key.Key_E: (0.0, 0.0, PIN_STEP),
 }
 PIN_TURNS = {Qt.Key.Key_Z: PIN_TURN, Qt.Key.Key_C: -PIN_TURN}
 #: The live cloth's fixed simulation step (seconds).
@@ -148,13 +153,20 @@ class _GLWindowSurface(QOpenGLWindow):
 CAMERA_PARAMETER = "view3d.camera"
 
 
-def ik_dofs(skeleton: Any, joint: int, chain_length: int) -> list[tuple[int, int]]:
+def ik_dofs(skeleton: Any, joint: int, chain_length: int, surface: bool = False) -> list[tuple[int, int]]:
     """The DOFs a right-drag on ``joint`` solves over: its ``chain_length`` nearest
     ancestors without the root; when those have no free DOF (a joint whose only ancestor
     is the root, like the demo arm's elbow) the root's rotation is used, so the drag moves
-    something instead of nothing."""
+    something instead of nothing. A drag on a point of the skin (``surface``: the effector
+    is off the joint's pivot) moves ``chain_length`` joints counting the joint itself,
+    whose own rotation now moves the point (the root's only when the root is clicked)."""
     from qtanimator.core.ik3d import chain_dofs
 
+    if surface:
+        own = [(joint, a) for a, d in enumerate(skeleton.joints[joint].dofs) if d.max - d.min > 1e-12]
+        if skeleton.joints[joint].parent is None:
+            return own
+        return own + chain_dofs(skeleton, joint, max(chain_length - 1, 0))
     dofs = chain_dofs(skeleton, joint, chain_length)
     return dofs or chain_dofs(skeleton, joint, chain_length, include_root=True)
 
@@ -286,6 +298,10 @@ class Viewport3D(QWidget):
             self._seen_live = live.version
             self.update()
         busy = worker.busy
+        live_errors = tuple(sorted(live.errors.items()))
+        if live_errors != getattr(self, "_seen_live_errors", ()):
+            self._seen_live_errors = live_errors   # a live cloth blew up: the Cloth dock says why
+            self.clothProgressChanged.emit(worker.progress())
         if worker.version != self._seen_worker:
             self._seen_worker = worker.version
             if self.cloth_stale:
@@ -600,8 +616,21 @@ class Viewport3D(QWidget):
             # over a skin the skeleton is drawn as spheres and bones: pick those
             items = [dataclasses.replace(i, boxmin=None, boxmax=None)
                      if isinstance(i, CharacterDraw) and i.skin is not None else i for i in items]
+        # Locked assets (outliner) are drawn but not picked; hidden ones are not drawn.
+        items = [i for i in items if not is_locked(self.ctx.doc, getattr(i, "asset_id", ""))]
         origin, direction = self.ray_at(pos)
         return pick_joint(items, origin, direction)
+
+    def pick_surface(self, pos: QPointF) -> Any:
+        """The point of a shown skin under a widget position
+        (:class:`~qtanimator.document.surface_pick.SurfaceHit`), or None (skins hidden, a miss)."""
+        from qtanimator.document.surface_pick import pick_surfaces
+
+        if not self.options.show_skin:
+            return None
+        ids = [i.asset_id for i in self.build_items() if isinstance(i, CharacterDraw) and i.skin is not None]
+        origin, direction = self.ray_at(pos)
+        return pick_surfaces(self.ctx.doc, ids, self.ctx.time, origin, direction)
 
     def gizmo_size(self) -> float:
         return 0.015 * self.camera.distance
@@ -613,6 +642,8 @@ class Viewport3D(QWidget):
         origin, direction = self.ray_at(pos)
         best = None
         for name, light in zip(LIGHT_NAMES, lights_of(self.ctx.doc)):
+            if not pickable(self.ctx.doc, name):
+                continue  # locked or switched off in the outliner
             t = ray_sphere(origin, direction, light.position, 1.5 * self.gizmo_size())
             if t is not None and (best is None or t < best[1]):
                 best = (name, t)
@@ -753,21 +784,31 @@ class Viewport3D(QWidget):
 
     # ------------------------------------------------------------------ IK
     def _start_ik(self, pos: QPointF) -> dict[str, Any] | None:
-        """Begin a right-drag IK gesture on the joint under ``pos`` (None: nothing to drag)."""
-        hit = self.pick(pos)
-        if hit is None:
-            return None
-        asset_id, joint, _t = hit
+        """Begin a right-drag IK gesture (None: nothing to drag). On a shown skin the point
+        under the cursor is dragged: the effector is that point in the frame of the joint
+        influencing it most. Elsewhere (skin hidden or missed) a joint's sphere, bone or box
+        is picked and its pivot dragged."""
+        surface = self.pick_surface(pos)
+        offset = None
+        if surface is not None:
+            asset_id, joint, offset, anchor = surface.asset_id, surface.joint, surface.offset, surface.point
+        else:
+            hit = self.pick(pos)
+            if hit is None:
+                return None
+            asset_id, joint, _t = hit
         runtime = self.ctx.doc.runtime.get(asset_id)
         skel = getattr(runtime, "skeleton", None)
-        if skel is None or not ik_dofs(skel, joint, self.ik_chain_length):
+        if skel is None or not ik_dofs(skel, joint, self.ik_chain_length, surface=offset is not None):
             return None   # nothing can move this joint (the root): right-drag zooms
         key = self._joint_key(asset_id, joint)
         self.ctx.select(asset_id, key)
-        world = self._pose(asset_id).world_matrices()
+        if offset is None:
+            anchor = self._pose(asset_id).world_matrices()[joint, :3, 3].copy()
         from qtanimator.document.pose import autokey
-        return {"asset": asset_id, "joint": joint, "anchor": world[joint, :3, 3].copy(),
-                "autokey": autokey(self.ctx.doc), "gesture": self.ctx.begin_gesture(f"IK drag {key}")}
+        return {"asset": asset_id, "joint": joint, "anchor": np.asarray(anchor, dtype=float).copy(),
+                "offset": offset, "autokey": autokey(self.ctx.doc),
+                "gesture": self.ctx.begin_gesture(f"IK drag {key}")}
 
     def _pose(self, asset_id: str) -> Any:
         from qtanimator.document import character3d
@@ -787,8 +828,9 @@ class Viewport3D(QWidget):
         asset_id, joint = self._drag["asset"], self._drag["joint"]
         doc, time = self.ctx.doc, self.ctx.time
         skel = character3d.character(doc, asset_id).skeleton  # the chain: structure only
+        offset = self._drag.get("offset")
         values = character3d.ik_values(doc, asset_id, joint, target, time,
-                                       ik_dofs(skel, joint, self.ik_chain_length))
+                                       ik_dofs(skel, joint, self.ik_chain_length, surface=offset is not None), offset)
         if not values:
             return
         gesture = self._drag["gesture"]
@@ -851,6 +893,24 @@ class Viewport3D(QWidget):
         self.ctx.push(command)
         return True
 
+    def reset_pose(self) -> bool:
+        """R: the selected character back to its rest pose, keyed now (as the joint tree's
+        Reset Pose; one undo step)."""
+        from qtanimator.ui.joint_tree import reset_pose_command
+
+        asset = self.ctx.selection[0]
+        command = reset_pose_command(self.ctx.doc, asset, self.ctx.time) if asset else None
+        if command is None:
+            self._say("Select a character to reset its pose.")
+            return False
+        self.ctx.push(command)
+        return True
+
+    def reset_cloth(self) -> None:
+        """Shift+R (and the Cloth dock's Reset): every live cloth back to its rest shape."""
+        self.live.reset()
+        self.update()
+
     # ----------------------------------------------------------------- keys
     def keyPressEvent(self, event: QKeyEvent) -> None:
         key = event.key()
@@ -883,9 +943,10 @@ class Viewport3D(QWidget):
             self.update()
         elif key == Qt.Key.Key_P:
             self.live.paused = not self.live.paused
-        elif key == Qt.Key.Key_R:
-            self.live.reset()
-            self.update()
+        elif key == Qt.Key.Key_R and mods == shift:
+            self.reset_cloth()
+        elif key == Qt.Key.Key_R and mods == Qt.KeyboardModifier.NoModifier:
+            self.reset_pose()
         elif key == Qt.Key.Key_Escape and self._drag is not None and self._drag.get("mode") in ("ik", "light"):
             self._drag["gesture"].abort()   # the document goes back exactly; nothing to undo
             self._drag = None

@@ -4,6 +4,7 @@
 in vec3 v_world;
 in vec3 v_normal;
 in vec4 v_color;
+in vec2 v_texcoord;
 
 uniform vec3 u_eye;
 uniform vec3 u_ambient;          // ambient light colour (times the material colour)
@@ -14,6 +15,8 @@ uniform float u_shininess;
 uniform int u_lit;               // 0: flat colour (grid, wireframe, gizmos)
 uniform int u_faceted;           // 1: face normals from screen-space derivatives
 uniform int u_two_sided;         // 1: light back faces with the flipped normal
+uniform int u_textured;          // 1: the base colour times u_texture at v_texcoord
+uniform sampler2D u_texture;
 
 out vec4 frag_color;
 
@@ -32,6 +35,7 @@ void main() {
     vec3 v = normalize(u_eye - v_world);
     if (u_faceted == 1 && dot(n, v) < 0.0) n = -n;
     vec3 base = v_color.rgb;
+    if (u_textured == 1) base *= texture(u_texture, v_texcoord).rgb;
     vec3 colour = u_ambient * base;
     for (int i = 0; i < 2; ++i) {
         vec3 l = normalize(u_light_pos[i] - v_world);

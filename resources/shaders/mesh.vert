@@ -16,6 +16,7 @@ layout(location = 5) in vec4 a_model1;
 layout(location = 6) in vec4 a_model2;
 layout(location = 7) in vec4 a_model3;
 layout(location = 8) in vec4 a_icolor;   // per-instance colour
+layout(location = 9) in vec2 a_texcoord; // texture coordinates (t = 0 at the image's top)
 
 uniform mat4 u_model;
 uniform mat4 u_view;
@@ -31,6 +32,7 @@ uniform int u_weight_mode;      // -2: off, -1: all joints pseudo-colour, >=0: t
 out vec3 v_world;
 out vec3 v_normal;
 out vec4 v_color;
+out vec2 v_texcoord;
 
 mat4 joint_matrix(int j) {
     return mat4(texelFetch(u_joint_tex, 4 * j), texelFetch(u_joint_tex, 4 * j + 1),
@@ -87,5 +89,6 @@ void main() {
     v_world = world.xyz;
     v_normal = normal_transform(mat3(model), n);
     v_color = colour;
+    v_texcoord = a_texcoord;
     gl_Position = u_proj * u_view * world;
 }

@@ -239,9 +239,11 @@ def test_demo_project_opens_and_animates() -> None:
     from qtanimator.paths import demo_project
 
     doc = open_document(demo_project())
-    # Pip, the clock and Robo in 2D; the 3D arm and a cloth flag (issue 9: one combined demo).
+    # Pip, the clock and Robo in 2D; the 3D arm and a cloth flag (issue 9: one combined demo);
+    # the walker with its cape (issue 14: cloth on a character).
     assert {a.id: a.kind for a in doc.assets.values()} == {
-        "pip": ASSET_KIND, "pendulum_clock": ASSET_KIND, "robot": ASSET_KIND, "arm": "character3d", "flag": "cloth"}
+        "pip": ASSET_KIND, "pendulum_clock": ASSET_KIND, "robot": ASSET_KIND, "arm": "character3d", "flag": "cloth",
+        "walker": "character3d", "cape": "cloth"}
     pip = character(doc, "pip")
     a, b = evaluate_pose(doc, "pip", 0.0), evaluate_pose(doc, "pip", 1.0)
     assert not np.allclose(a.world, b.world)

@@ -184,3 +184,28 @@ def test_the_dock_says_when_the_cloth_runs_without_the_compiled_solver(qtbot, mo
     assert label is not None
     assert label.isVisibleTo(w) == (note is not None)
     assert label.text() == (note or "")
+
+
+def test_a_blow_up_is_explained_in_the_dock_and_the_status_bar(qtbot):
+    """Issue 14: wind 1000 on the demo flag stops it; the dock and the status bar say why and
+    name the parameter to change."""
+    from pathlib import Path
+
+    from qtanimator.ui import viewport
+
+    w = MainWindow(install_editors=False)
+    viewport.install(w)
+    cloth_panel.install(w)
+    qtbot.addWidget(w)
+    w.show()
+    demo = Path(__file__).resolve().parents[2] / "scenes" / "demo" / "demo.qtanim"
+    assert w.open_path(demo)
+    panel = w.cloth_panel
+    panel.asset.setCurrentText("flag")
+    assert panel.edit("wind", (1000.0, 0.0, 0.0))
+    worker = w.viewport3d.cloth_worker
+    assert worker.wait(60)
+    qtbot.waitUntil(lambda: panel.problem.isVisibleTo(panel), timeout=5000)
+    text = panel.findChild(QLabel, "clothProblem").text()
+    assert "flag" in text and "blew up" in text and "'substeps'" in text
+    assert "blew up" in w.statusBar().currentMessage()

@@ -181,16 +181,16 @@ def test_cloth_keys_move_the_pins_of_the_live_cloth(window, qtbot):
     qtbot.keyClick(view, Qt.Key.Key_D)
     qtbot.keyClick(view, Qt.Key.Key_D)
     qtbot.keyClick(view, Qt.Key.Key_Q)
-    np.testing.assert_allclose(cloth.pin_targets - before,
-                               np.tile([2 * viewport.PIN_STEP, viewport.PIN_STEP, 0.0], (len(before), 1)), atol=1e-12)
+    qtbot.keyClick(view, Qt.Key.Key_W)   # CSE169: W up (y), Q in (−z)
+    moved = [2 * viewport.PIN_STEP, viewport.PIN_STEP, -viewport.PIN_STEP]
+    np.testing.assert_allclose(cloth.pin_targets - before, np.tile(moved, (len(before), 1)), atol=1e-12)
     qtbot.keyClick(view, Qt.Key.Key_Z)
     centre = cloth.pin_targets.mean(axis=0)
-    assert not np.allclose(cloth.pin_targets, before + [2 * viewport.PIN_STEP, viewport.PIN_STEP, 0.0])
-    np.testing.assert_allclose(centre, before.mean(axis=0) + [2 * viewport.PIN_STEP, viewport.PIN_STEP, 0.0],
-                               atol=1e-9)
+    assert not np.allclose(cloth.pin_targets, before + moved)
+    np.testing.assert_allclose(centre, before.mean(axis=0) + moved, atol=1e-9)
     view.live.step(1 / 60)      # one step now, on this thread
     np.testing.assert_allclose(cloth.positions[cloth.pinned], cloth.pin_targets, atol=1e-9)
-    view.live.reset()
+    qtbot.keyClick(view, Qt.Key.Key_R, Qt.KeyboardModifier.ShiftModifier)   # Shift+R resets the cloth
     np.testing.assert_allclose(cloth.pin_targets, before)
     view.set_live_cloth(False)
 
@@ -625,3 +625,23 @@ def test_right_drag_ik_on_a_gltf_character_below_its_placement_keys_quaternions(
     qw = window.doc.channels[f"{aid}/{keys[parent]}/qw"]
     assert qw.key_index(window.ctx.time) is not None
     assert f"{aid}/{keys[parent]}/rx" not in window.doc.channels
+
+
+def test_r_in_the_3d_view_resets_the_selected_characters_pose(window, qtbot):
+    from pathlib import Path
+
+    from qtanimator.document.character3d import add_character3d_command, pose_skeleton, set_dofs_command
+
+    arm = Path(__file__).resolve().parents[2] / "scenes" / "arm3d"
+    doc = window.doc
+    window.ctx.push(add_character3d_command(doc, arm / "arm.skel", arm / "arm.skin", asset_id="arm"))
+    t = window.ctx.time
+    window.ctx.push(set_dofs_command(doc, "arm", {(0, "z"): 0.7, (1, "z"): 1.1}, t))
+    window.ctx.select("arm", "")
+    view = window.viewport3d
+    view.setFocus()
+    qtbot.keyClick(view, Qt.Key.Key_R)     # a real key event on the 3D view
+    pose = pose_skeleton(doc, "arm", t)
+    assert all(abs(v) < 1e-12 for j in pose.joints for v in j.pose)   # CSE169's R: zero angles
+    window.ctx.undo_stack.undo()            # one undo step
+    assert pose_skeleton(doc, "arm", t).joints[1].pose[2] == pytest.approx(1.1)

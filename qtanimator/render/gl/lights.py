@@ -46,10 +46,12 @@ def parameter(doc: Any, path: str) -> Any:
 
 def lights_of(doc: Any) -> list[Light]:
     out = []
+    params = doc if isinstance(doc, dict) else doc.parameters
     for name in LIGHT_NAMES:
+        hidden = bool(params.get(f"{name}.hidden", False))  # switched off in the outliner
         out.append(Light(np.asarray(parameter(doc, f"{name}.position"), dtype=float).reshape(3),
                          np.clip(np.asarray(parameter(doc, f"{name}.color"), dtype=float).reshape(3), 0, 1),
-                         max(float(parameter(doc, f"{name}.intensity")), 0.0)))
+                         0.0 if hidden else max(float(parameter(doc, f"{name}.intensity")), 0.0)))
     return out
 
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 from OpenGL import GL
 
-A_POSITION, A_NORMAL, A_COLOR, A_INFLUENCE, A_MODEL, A_ICOLOR = 0, 1, 2, 3, 4, 8
+A_POSITION, A_NORMAL, A_COLOR, A_INFLUENCE, A_MODEL, A_ICOLOR, A_TEXCOORD = 0, 1, 2, 3, 4, 8, 9
 
 
 def _buffer(target: int, data: np.ndarray, usage: int = GL.GL_STATIC_DRAW) -> int:
@@ -160,7 +160,8 @@ class SkinnedMesh(Mesh):
     """
 
     def __init__(self, positions: np.ndarray, normals: np.ndarray | None, triangles: np.ndarray,
-                 influence: np.ndarray, pairs: np.ndarray, joint_count: int) -> None:
+                 influence: np.ndarray, pairs: np.ndarray, joint_count: int,
+                 texcoords: np.ndarray | None = None) -> None:
         super().__init__(positions, normals, triangles)
         influence = np.ascontiguousarray(influence, dtype=np.float32)
         pairs = np.ascontiguousarray(pairs, dtype=np.float32).reshape(-1, 2)
@@ -171,6 +172,10 @@ class SkinnedMesh(Mesh):
         GL.glBindVertexArray(self.vao)
         self.vbo_inf = _buffer(GL.GL_ARRAY_BUFFER, influence)
         _attribute(A_INFLUENCE, self.vbo_inf, 2)
+        self.vbo_uv = 0
+        if texcoords is not None:  # (N, 2), t = 0 at the image's top row
+            self.vbo_uv = _buffer(GL.GL_ARRAY_BUFFER, np.ascontiguousarray(texcoords, dtype=np.float32).reshape(-1, 2))
+            _attribute(A_TEXCOORD, self.vbo_uv, 2)
         GL.glBindVertexArray(0)
         self.influences = TextureBuffer(pairs, GL.GL_RG32F)
         self.joints = TextureBuffer(np.tile(np.eye(4, dtype=np.float32), (max(self.joint_count, 1), 1, 1)),
@@ -188,6 +193,8 @@ class SkinnedMesh(Mesh):
 
     def delete(self) -> None:
         GL.glDeleteBuffers(1, [self.vbo_inf])
+        if self.vbo_uv:
+            GL.glDeleteBuffers(1, [self.vbo_uv])
         self.influences.delete()
         self.joints.delete()
         super().delete()

@@ -27,6 +27,7 @@ from qtanimator.render.gl.meshes import (
     sphere_geometry,
 )
 from qtanimator.render.gl.program import Program
+from qtanimator.render.gl.textures import TextureCache
 
 SKIN_COLOR = (0.78, 0.74, 0.68, 1.0)
 BONE_COLOR = (0.62, 0.66, 0.74, 1.0)
@@ -94,6 +95,11 @@ class SkinDraw:
     #: (first triangle, triangle count, RGBA colour) of each part drawn in its own colour
     #: (a character's meshes with their materials); empty: the whole skin in SKIN_COLOR.
     parts: tuple[tuple[int, int, tuple[float, float, float, float]], ...] = ()
+    #: (N, 2) texture coordinates, t = 0 at the image's top row (None: no textures drawn)
+    texcoords: np.ndarray | None = None
+    #: (first triangle, triangle count, RGBA base colour, image or None) covering the skin
+    #: when some part has an image (a TextureImage, decoded here): drawn instead of ``parts``.
+    textures: tuple[tuple[int, int, tuple[float, float, float, float], Any], ...] = ()
 
 
 @dataclass
@@ -218,6 +224,7 @@ class SceneRenderer:
         self._skins: dict[str, tuple[Any, SkinnedMesh]] = {}
         self._cloths: dict[str, tuple[int, int, Mesh]] = {}
         self._feedback: Program | None = None
+        self.textures = TextureCache()
         self.stats: dict[str, int] = {}
 
     def initialize(self) -> None:
@@ -243,6 +250,7 @@ class SceneRenderer:
             cloth.delete()
         self._skins.clear()
         self._cloths.clear()
+        self.textures.release()
         for prog in (self.program, self._feedback):
             if prog is not None:
                 prog.delete()
@@ -279,6 +287,7 @@ class SceneRenderer:
         prog.set("u_shininess", 32.0)
         prog.set("u_joint_tex", 0)
         prog.set("u_influence_tex", 1)
+        prog.set("u_texture", 2)
         self._reset_state()
         self.stats = {"draw_calls": 0, "triangles": 0}
 
@@ -319,6 +328,7 @@ class SceneRenderer:
         if opts.show_lights:
             self._draw_light_gizmos(lights, opts.light_gizmo_size)
         self._forget(live_skins, live_cloths)
+        self.textures.sweep()
         GL.glUseProgram(0)
 
     # -------------------------------------------------------------- helpers
@@ -332,6 +342,7 @@ class SceneRenderer:
         p.set("u_lit", 1)
         p.set("u_faceted", 0)
         p.set("u_two_sided", 0)
+        p.set("u_textured", 0)
         p.set("u_model", np.eye(4))
 
     def _count(self, mesh: Mesh, instances: int = 1) -> None:
@@ -497,7 +508,7 @@ class SceneRenderer:
         if cached is not None:
             cached[1].delete()
         mesh = SkinnedMesh(skin.positions, skin.normals, skin.triangles, skin.influence, skin.pairs,
-                           len(skin.matrices))
+                           len(skin.matrices), skin.texcoords)
         self._skins[asset_id] = (skin.key, mesh)
         return mesh
 
@@ -516,7 +527,34 @@ class SceneRenderer:
         if mode >= 0 and opts.weight_asset is not None and opts.weight_asset != item.asset_id:
             mode = WEIGHTS_OFF
         p.set("u_weight_mode", mode)
-        self._draw_surface(mesh, opts.wireframe, skin.parts)
+        if skin.textures and skin.texcoords is not None and mode == WEIGHTS_OFF:
+            self._draw_textured(mesh, opts.wireframe, skin.textures)
+        else:
+            self._draw_surface(mesh, opts.wireframe, skin.parts)
+
+    def _draw_textured(self, mesh: Mesh, wireframe: bool,
+                       ranges: Sequence[tuple[int, int, tuple[float, float, float, float], Any]]) -> None:
+        """Draw each range in its base colour, times its image where it has one (texture unit 2)."""
+        p = self.program
+        assert p is not None
+        if wireframe:
+            GL.glEnable(GL.GL_POLYGON_OFFSET_FILL)
+            GL.glPolygonOffset(1.0, 1.0)
+        for first, count, color, image in ranges:
+            p.set("u_color", np.asarray(color, dtype=float))
+            p.set("u_textured", 0 if image is None else 1)
+            if image is not None:
+                GL.glActiveTexture(GL.GL_TEXTURE2)
+                GL.glBindTexture(GL.GL_TEXTURE_2D, self.textures.get(image))
+                GL.glActiveTexture(GL.GL_TEXTURE0)
+            mesh.draw_range(3 * first, 3 * count)
+            self.stats["draw_calls"] += 1
+            self.stats["triangles"] += count
+        p.set("u_textured", 0)
+        if wireframe:
+            GL.glDisable(GL.GL_POLYGON_OFFSET_FILL)
+            self._wire(mesh)
+        self._reset_state()
 
     def skin_on_gpu(self, skin: SkinDraw, key: str = "_capture") -> tuple[np.ndarray, np.ndarray]:
         """Run the skinning vertex shader on every vertex and read back world positions and
@@ -535,7 +573,8 @@ class SceneRenderer:
         prog.use()
         for name, value in (("u_model", np.eye(4)), ("u_view", np.eye(4)), ("u_proj", np.eye(4)),
                             ("u_instanced", 0), ("u_use_vertex_color", 0), ("u_skinning", 1),
-                            ("u_weight_mode", WEIGHTS_OFF), ("u_joint_tex", 0), ("u_influence_tex", 1)):
+                            ("u_weight_mode", WEIGHTS_OFF), ("u_joint_tex", 0), ("u_influence_tex", 1),
+                            ("u_texture", 2), ("u_textured", 0)):
             prog.set(name, value)
         mesh.bind_textures()
         GL.glEnable(GL.GL_RASTERIZER_DISCARD)
