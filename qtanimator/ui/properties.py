@@ -2,7 +2,8 @@
 
 Everything editable is a document parameter changed through a command (SetParameter, or
 ``character2d.set_pendulum_preset`` for a preset), or an asset property changed through its
-own command (a BVH character's position convention, the clip a glTF character plays), so it
+own command (a BVH character's position convention, the clip a glTF character plays, the
+collision radius of a 3D character's bone that attached cloth collides with), so it
 is undoable and saved with the project. Read-only facts (mass, inertia, pivot…) are shown as labels.
 """
 
@@ -22,8 +23,10 @@ from PySide6.QtWidgets import (
     QDoubleSpinBox,
     QFormLayout,
     QGroupBox,
+    QHBoxLayout,
     QLabel,
     QScrollArea,
+    QToolButton,
     QVBoxLayout,
     QWidget,
 )
@@ -35,7 +38,7 @@ from qtanimator.document.ik_settings import BEND_DIRECTIONS, IK_SOLVERS
 from qtanimator.ui.clip_picker import ClipCombo, clip_characters
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.joint_tree import c2d, c3d
-from qtanimator.ui.widgets import CheckedDoubleSpinBox, CheckedSpinBox
+from qtanimator.ui.widgets import CheckedDoubleSpinBox, CheckedSpinBox, format_number
 
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
@@ -610,12 +613,82 @@ class PropertiesPanel(QWidget):
             form.addRow("Offset", QLabel("({:.3f}, {:.3f}, {:.3f})".format(*(float(v) for v in j.offset))))
             for axis, dof in zip("xyz", j.dofs):
                 form.addRow(f"Limits {axis}", QLabel(_limits_text(float(dof.min), float(dof.max))))
+            self._capsule_radius_editor(form, asset, joint)
         else:
             form.addRow("Joints", QLabel(str(len(names))))
         self._bvh_positions_editor(form, asset)
         self._clip_editor(form, asset)
         self._rotation_mode_editor(form, asset)
         return group
+
+    def _capsule_radius_editor(self, form: QFormLayout, asset: str, joint: str) -> None:
+        """The collision radius of the bone ending at ``joint`` (issue 14 item 5): the capsule
+        from its parent to it that an attached cloth collides with. It shows the character's
+        ``capsule_radii`` override or the skin's default (with a hint); a typed value and Reset
+        are one undoable command each."""
+        from qtanimator.document import cloth_attach as ca
+
+        m3 = c3d()
+        doc = self.ctx.doc
+        if m3 is None or doc.assets[asset].kind != m3.ASSET_KIND:
+            return
+        defaults = ca.default_capsule_radii(m3.character(doc, asset))  # once: it reads the whole skin
+        if joint not in defaults:  # the root: no bone ends here
+            return
+
+        def override() -> float | None:
+            value = (doc.assets[asset].properties.get(ca.CAPSULE_RADII) or {}).get(joint)
+            return None if value is None else float(value)
+
+        def shown() -> float:
+            value = override()
+            return defaults[joint] if value is None else value
+
+        def push(radius: float | None) -> None:
+            if radius is None and override() is None:
+                return
+            if radius is not None and (radius <= 0.0 or abs(shown() - radius) <= 1e-12):
+                return
+            command = ca.set_capsule_radius_command(doc, asset, joint, radius)
+            # The change rebuilds this panel, deleting the field: push after its signal returns.
+            QTimer.singleShot(0, lambda: self.ctx.push(command))
+
+        row = QWidget()
+        layout = QHBoxLayout(row)
+        layout.setContentsMargins(0, 0, 0, 0)
+        box = CheckedDoubleSpinBox(label="Collision radius")
+        box.setObjectName("capsuleRadius")
+        box.setKeyboardTracking(False)
+        box.setDecimals(4)
+        box.setRange(1e-4, 1e4)
+        magnitude = defaults[joint]
+        box.setSingleStep(10 ** math.floor(math.log10(magnitude)) if magnitude > 0 else 0.01)
+        box.setToolTip(f"Radius of the capsule around the bone ending at {joint} (from its parent joint), "
+                       "which cloth attached to this character collides with. Default: the median distance "
+                       f"of the skin to the bone ({format_number(defaults[joint])}).")
+        box.valueChanged.connect(lambda v: push(float(v)))
+        hint = QLabel()
+        hint.setObjectName("capsuleRadiusHint")
+        reset = QToolButton()
+        reset.setObjectName("capsuleRadiusReset")
+        reset.setText("Reset")
+        reset.setToolTip("Go back to the radius from the skin")
+        reset.clicked.connect(lambda: push(None))
+        layout.addWidget(box, 1)
+        layout.addWidget(hint)
+        layout.addWidget(reset)
+        form.addRow("Collision radius", row)
+        self.editors["capsule_radius"] = box
+
+        def refresh() -> None:
+            box.blockSignals(True)
+            box.setValue(shown())
+            box.blockSignals(False)
+            overridden = override() is not None
+            hint.setText("" if overridden else "default")
+            reset.setEnabled(overridden)
+
+        self._refreshers.append(refresh)
 
     def _placement_group(self, asset: str, dims: int) -> QGroupBox:
         """The character's authored placement (issue 14): translate, rotate (degrees; one angle

@@ -9,6 +9,9 @@ Mouse (the reference animator's, plus a view you can move):
 * every drag is one gesture (``ctx.begin_gesture``): each mouse move previews its command
   at once, the release records one undo step, Escape takes the drag back exactly;
 * middle-drag pans, the wheel zooms about the cursor, F fits the scene in the view.
+* Alt+left-drag on a character moves its placement (issue 14; ``document.placement``),
+  Alt+Shift+left-drag scales it about its pivot (×2 per 100 px to the right): one undo step
+  each, Escape takes it back.
 
 Auto-key (the timeline's record button, ``document.pose``): on, every drag keys; off, a
 drag only poses — the unkeyed pose is shown until the frame changes or it is keyed (the
@@ -314,8 +317,9 @@ class RigEditorView(QGraphicsView):
         if sel_asset != asset:
             return None
         character = self.ctx.doc.runtime.get(asset)
-        if character is None:
-            return None
+        asset_obj = self.ctx.doc.assets.get(asset)
+        if character is None or asset_obj is None or asset_obj.kind != _c2d().ASSET_KIND:
+            return None  # this editor draws 2D characters only (a 3D joint may be selected)
         if joint == "":
             return 0
         try:
@@ -461,6 +465,21 @@ class RigEditorView(QGraphicsView):
             if playback is not None:
                 playback.pause()
             time = self.ctx.time
+        alt = Qt.KeyboardModifier.AltModifier
+        if button == Qt.MouseButton.LeftButton and hit is not None and event.modifiers() & alt:
+            # Alt+drag places the character (issue 14), Alt+Shift+drag scales it: one undo step.
+            asset = hit[0]
+            self.ctx.select(asset, "")
+            if event.modifiers() & Qt.KeyboardModifier.ShiftModifier:
+                self._gesture = self._new_gesture(f"Scale {asset}")
+                self._drag = ri.placement_scale_drag(self.ctx.doc, asset, point, self._pixel_size())
+            else:
+                self._gesture = self._new_gesture(f"Place {asset}")
+                self._drag = ri.placement_move_drag(self.ctx.doc, asset, point)
+            next(self._drag)
+            self._drag_button = button
+            event.accept()
+            return
         if button == Qt.MouseButton.LeftButton:
             if hit is None:
                 self.ctx.select("", "")

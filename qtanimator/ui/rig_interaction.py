@@ -134,6 +134,45 @@ def ik_drag(doc: Document, asset: str, joint: int, press: Sequence[float], time:
         cursor = yield command
 
 
+#: Placement scale drags (Alt+Shift+left-drag): the scale doubles for every this many pixels
+#: the cursor moves right (halves moving left), so it stays above zero.
+SCALE_DOUBLING_PX = 100.0
+
+
+def placement_move_drag(doc: Document, asset: str, press: Sequence[float]) -> Drag:
+    """Alt+left-drag on a character: move its authored placement (issue 14) with the cursor —
+    translate = translate at the press + cursor − press (scene units)."""
+    from qtanimator.document.placement import placement_of, set_placement_command
+
+    start = placement_of(doc, asset, 2)
+    t0 = np.asarray(start["translate"], dtype=np.float64)
+    p0 = np.asarray(press, dtype=np.float64)
+    cursor = yield None
+    while True:
+        t = t0 + (np.asarray(cursor, dtype=np.float64) - p0)
+        cursor = yield set_placement_command(doc, asset, {**start, "translate": [float(t[0]), float(t[1])]},
+                                             text=f"Place {asset}")
+
+
+def placement_scale(start: float, dx_px: float) -> float:
+    """The uniform scale after a horizontal drag of ``dx_px`` pixels: ``start · 2^(dx/100)``."""
+    return float(start) * 2.0 ** (float(dx_px) / SCALE_DOUBLING_PX)
+
+
+def placement_scale_drag(doc: Document, asset: str, press: Sequence[float], pixel_size: float) -> Drag:
+    """Alt+Shift+left-drag on a character: scale its placement uniformly about its pivot (the
+    rest root pivot, :func:`qtanimator.document.placement.matrix2d`) by the horizontal motion
+    (:func:`placement_scale`; ``pixel_size`` is scene units per pixel)."""
+    from qtanimator.document.placement import placement_of, set_placement_command
+
+    start = placement_of(doc, asset, 2)
+    x0 = float(press[0])
+    cursor = yield None
+    while True:
+        s = placement_scale(start["scale"], (float(cursor[0]) - x0) / pixel_size)
+        cursor = yield set_placement_command(doc, asset, {**start, "scale": s}, text=f"Scale {asset}")
+
+
 def ik_source(doc: Document, asset: str, joint: int, press: Sequence[float], time: float) -> FloatArray:
     """The rest-pose point of ``joint`` under ``press`` (kept for the debug dot)."""
     pose = c2d.evaluate_pose(doc, asset, time, block=False)

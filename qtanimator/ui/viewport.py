@@ -7,14 +7,16 @@ playback controls.
 
 Mouse: left click picks a joint (``ctx.select``); left drag orbits (on a live cloth it grabs
 the cloth, on a light's sphere it moves the light); middle drag or Shift+left pans; wheel or
-Ctrl+left zooms; right drag on a skin moves the point under the cursor by IK (that point in
+Ctrl+left zooms; Alt+left drag on a character moves its placement in the view plane through
+its root, Alt+Shift+left scales it about the root (issue 14; one undo step each); right drag
+on a skin moves the point under the cursor by IK (that point in
 the frame of the joint influencing it most; on a joint's sphere or bone, with the skin hidden
 or missed, the joint's pivot), one undo step, keyed at the current frame; right drag elsewhere
 zooms. Keys: F frames the selection (or everything),
 X shows the axes (the MIT viewer's ``a``), B the skeleton (its ``s``), W/A/S/D/Q/E move a live
 cloth's pins (CSE169: W/S in y, A/D in x, Q/E in z), Z/C rotate them, P pauses the live cloth,
-Shift+R resets it, R resets the selected character's pose, Escape cancels an IK or
-light drag. View ▸ 3D Camera… shows the camera's distance, azimuth and inclination as fields
+Shift+R resets it, R resets the selected character's pose, Escape cancels an IK, light or
+placement drag. View ▸ 3D Camera… shows the camera's distance, azimuth and inclination as fields
 (:mod:`qtanimator.ui.camera_fields`); the toolbar's *Shadow* draws the floor shadow.
 
 Cloth never runs on the UI thread: a :class:`~qtanimator.document.cloth_worker.ClothWorker`
@@ -663,7 +665,11 @@ class Viewport3D(QWidget):
         button, mods = event.button(), event.modifiers()
         mode = "orbit"
         extra: dict[str, Any] = {}
-        if button == Qt.MouseButton.MiddleButton or (
+        place = (self._start_place(pos, scale=bool(mods & Qt.KeyboardModifier.ShiftModifier))
+                 if button == Qt.MouseButton.LeftButton and mods & Qt.KeyboardModifier.AltModifier else None)
+        if place is not None:
+            mode, extra = "place", place
+        elif button == Qt.MouseButton.MiddleButton or (
                 button == Qt.MouseButton.LeftButton and mods & Qt.KeyboardModifier.ShiftModifier):
             mode = "pan"
         elif button == Qt.MouseButton.LeftButton and mods & Qt.KeyboardModifier.ControlModifier:
@@ -712,6 +718,8 @@ class Viewport3D(QWidget):
             self._drag_grab(pos)
         elif mode == "light":
             self._drag_light(pos)
+        elif mode == "place":
+            self._drag_place(pos)
         elif mode == "ik":
             self._drag_ik(pos)
         self._camera_moved()
@@ -751,6 +759,62 @@ class Viewport3D(QWidget):
             return
         value = [round(float(v), 4) for v in target]
         gesture.update(SetParameter(self.ctx.doc, f"{name}.position", value, text=f"Move {name}"))
+
+    # ------------------------------------------------------ placement drag
+    def _start_place(self, pos: QPointF, scale: bool) -> dict[str, Any] | None:
+        """Begin an Alt+left (move) or Alt+Shift+left (``scale``) drag of the placement of the
+        3D character under the cursor (its skin, else a joint); None: nothing picked."""
+        from qtanimator.document import character3d
+        from qtanimator.document.placement import placement_of
+
+        surface = self.pick_surface(pos)
+        if surface is not None:
+            asset_id = surface.asset_id
+        else:
+            hit = self.pick(pos)
+            if hit is None:
+                return None
+            asset_id = hit[0]
+        asset = self.ctx.doc.assets.get(asset_id)
+        if asset is None or asset.kind != character3d.ASSET_KIND:
+            return None
+        self.ctx.select(asset_id, "")
+        root = self._pose(asset_id).world_matrices()[0, :3, 3].copy()
+        press = self._on_view_plane(pos, root)
+        if press is None:
+            return None
+        verb = "Scale" if scale else "Place"
+        return {"asset": asset_id, "scale": scale, "anchor": np.asarray(root, dtype=float), "press": press,
+                "start": placement_of(self.ctx.doc, asset_id, 3), "press_x": float(pos.x()),
+                "gesture": self.ctx.begin_gesture(f"{verb} {asset_id}")}
+
+    def _drag_place(self, pos: QPointF) -> None:
+        """Move the placement with the cursor in the view plane through the character's root
+        (at the press), or scale it uniformly by the horizontal motion (×2 per 100 px to the
+        right) keeping the root where it is; one undo step."""
+        from qtanimator.document.placement import set_placement_command
+        from qtanimator.ui.rig_interaction import placement_scale
+
+        assert self._drag is not None
+        drag = self._drag
+        start, gesture = drag["start"], drag["gesture"]
+        if not gesture.active:
+            return
+        t0 = np.asarray(start["translate"], dtype=float)
+        if drag["scale"]:
+            s = placement_scale(start["scale"], float(pos.x()) - drag["press_x"])
+            # A = T(t)·R·S(s) scales about its origin: move t so the root stays put.
+            root = drag["anchor"]
+            t = root - (s / start["scale"]) * (root - t0)
+            value = {**start, "translate": [float(v) for v in t], "scale": s}
+            text = f"Scale {drag['asset']}"
+        else:
+            target = self._on_view_plane(pos, drag["anchor"])
+            if target is None:
+                return
+            value = {**start, "translate": [float(v) for v in t0 + (target - drag["press"])]}
+            text = f"Place {drag['asset']}"
+        gesture.update(set_placement_command(self.ctx.doc, drag["asset"], value, text=text))
 
     # ---------------------------------------------------------- cloth grab
     def _start_grab(self, pos: QPointF) -> bool:
@@ -947,7 +1011,7 @@ class Viewport3D(QWidget):
             self.reset_cloth()
         elif key == Qt.Key.Key_R and mods == Qt.KeyboardModifier.NoModifier:
             self.reset_pose()
-        elif key == Qt.Key.Key_Escape and self._drag is not None and self._drag.get("mode") in ("ik", "light"):
+        elif key == Qt.Key.Key_Escape and self._drag is not None and self._drag.get("mode") in ("ik", "light", "place"):
             self._drag["gesture"].abort()   # the document goes back exactly; nothing to undo
             self._drag = None
             self.update()

@@ -459,3 +459,19 @@ def test_playback_sprites_keep_what_the_svg_draws_beyond_the_geometry(make_windo
     assert shadow.sum() > 500      # something beyond the rectangle is drawn
     differ = np.abs(still[..., :3] - playing[..., :3]).max(axis=2) > 48
     assert differ.mean() < 0.01
+
+
+def test_selecting_a_3d_joint_while_the_2d_editor_shows_draws_without_error(qtbot, make_window, shared_data):
+    """The 2D editor's selected-joint overlays ignore a 3D character's joint (it once asked
+    the 3D character for a 2D joint index while painting)."""
+    from qtanimator.document.character3d import add_character3d_command
+
+    window = make_window()
+    window.ctx.push(add_character3d_command(window.doc, shared_data / "cse169" / "wasp_walk" / "wasp.skel",
+                                            asset_id="wasp"))
+    window.central_tabs.setCurrentWidget(window.rig_editor)
+    window.ctx.select("wasp", "knee_01_r")
+    view = window.rig_editor.view
+    assert view.selected_joint_index("wasp") is None
+    view.viewport().repaint()  # painting the overlays must not raise
+    qtbot.wait(10)
