@@ -96,7 +96,7 @@ __all__ = [
     "channel_ids", "character", "clip_channels_of", "clip_from_document", "clip_range_command", "dof_channel_id",
     "dof_values", "ik_values", "joint_channel_names", "load_anim_command", "load_bvh_character", "load_character3d",
     "load_character3d_asset", "load_skin_character", "new_key", "pose_channel_values", "pose_skeleton", "rotation_mode",
-    "set_bvh_positions_command", "set_clip_command", "set_dof_command", "set_dofs_command",
+    "set_bvh_positions_command", "set_clip_command", "set_dof_command", "set_dofs_command", "set_fps_command",
     "set_rotation_mode_command", "skin_texture", "skinned_mesh", "with_rotation_mode", "world_matrices",
 ]
 
@@ -712,11 +712,13 @@ def clip_duration(doc: Document, asset_id: str, name: str) -> tuple[float, float
     return start, end
 
 
-def clip_range_command(doc: Document, start: float, end: float) -> Command | None:
+def clip_range_command(doc: Document, start: float, end: float, fps: float | None = None) -> Command | None:
     """The document's frame range set to the frames covering ``start … end`` seconds (None:
-    it is that already)."""
-    first = int(np.floor(doc.time_to_frame(start) + 1e-6))
-    last = max(first, int(np.ceil(doc.time_to_frame(end) - 1e-6)))
+    it is that already). ``fps`` counts the frames at another rate than the document's (a
+    command that also changes it)."""
+    rate = doc.fps if fps is None else float(fps)
+    first = int(np.floor(start * rate + 1e-6))
+    last = max(first, int(np.ceil(end * rate - 1e-6)))
     commands: list[Command] = []
     if doc.frame_range[0] != first:
         commands.append(SetParameter(doc, "frame_start", first))
@@ -727,6 +729,23 @@ def clip_range_command(doc: Document, start: float, end: float) -> Command | Non
     if not commands:
         return None
     return commands[0] if len(commands) == 1 else Macro("Frame range", commands)
+
+
+def set_fps_command(doc: Document, fps: float) -> Command:
+    """One undo step that sets the project's frame rate (the ``fps`` parameter) and keeps
+    the frame range's time: keys are in seconds and stay, ``frame_start`` / ``frame_end``
+    are rescaled to the frames covering the same seconds at the new rate (the start rounded
+    down, the end up). Raises ValueError for a rate that is not a positive number."""
+    rate = float(fps)
+    if not (np.isfinite(rate) and rate > 0):
+        raise ValueError(f"frame rate must be a positive number, not {fps!r}")
+    value: float | int = int(rate) if rate.is_integer() else rate
+    first, last = doc.frame_range
+    commands: list[Command] = [SetParameter(doc, "fps", value)]
+    rng = clip_range_command(doc, doc.frame_to_time(first), doc.frame_to_time(last), rate)
+    if rng is not None:
+        commands.append(rng)
+    return Macro(f"Frame rate {rate:g} fps", commands)
 
 
 def set_clip_command(doc: Document, asset_id: str, name: str) -> Command:

@@ -19,7 +19,11 @@ the user (companion files that were picked up, approximations). The GUI's opener
   every animation as a clip (:mod:`qtanimator.document.gltf_character`).
 
 An import that brings a clip longer than the document's frame range also lengthens the range
-(in the same undo step), so the whole clip plays.
+(in the same undo step), so the whole clip plays. A ``.bvh`` or glTF clip keeps its own timing:
+into a document without keys, the project takes the clip's frame rate (a BVH's frame time, a
+glTF clip's key spacing when even) and the frame range fits the clip; into one with keys, the
+range only grows and a different rate is offered (:attr:`Import.clip_fps`,
+:func:`~qtanimator.document.character3d.set_fps_command`).
 
 """
 
@@ -28,7 +32,7 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-from collections.abc import Sequence
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -87,6 +91,9 @@ class Import:
     command: Command
     asset_id: str
     notes: list[str] = field(default_factory=list)
+    #: The clip's own frame rate when it differs from the document's and was not adopted
+    #: (the document already had keys): the window offers to set the project to it.
+    clip_fps: float | None = None
 
 
 # --------------------------------------------------------------------- companions
@@ -328,7 +335,63 @@ def bvh_import(doc: Document, path: str | os.PathLike[str]) -> Import:
     n = max((len(c.keys) for c in channels.values()), default=0)
     notes = [f"{len(runtime.skeleton.joints)} joints, {n} frames.", *runtime.notes]
     notes += place_new_character(doc, add)
-    return _with_range(doc, add.text, add, _channels_end(list(channels.values())), aid, notes)
+    return _timed(doc, add, 0.0, _channels_end(list(channels.values())), _key_rate(channels.values()), aid, notes)
+
+
+def _key_rate(channels: Iterable[Channel | None]) -> float | None:
+    """The frame rate of keys evenly spaced in time (a BVH's frames, a glTF clip sampled at a
+    fixed rate), whole when within 0.2 % of a whole number; None when the keys are not evenly
+    spaced, fewer than two, or under 10 per second (key poses rather than frames)."""
+    times = [c.times for c in channels if c is not None and len(c.keys) >= 2]
+    if not times:
+        return None
+    t = np.unique(np.round(np.concatenate(times), 6))
+    if len(t) < 2:
+        return None
+    steps = np.diff(t)
+    dt = float(np.median(steps))
+    if dt <= 0 or float(np.max(np.abs(steps - dt))) > max(1e-5, 1e-3 * dt):
+        return None
+    rate = 1.0 / dt
+    whole = float(round(rate))
+    rate = whole if abs(rate - whole) <= 2e-3 * rate else round(rate, 3)
+    return rate if 10.0 <= rate <= 1000.0 else None  # sparser keys are poses, not a frame rate
+
+
+def _timed(doc: Document, add: Command, start: float, end: float, rate: float | None, asset_id: str,
+           notes: list[str]) -> Import:
+    """An import of a clip spanning ``start … end`` s whose keys are ``rate`` per second (None:
+    uneven): into a document without keys the project takes the clip's rate and its frame
+    range fits the clip; otherwise the range only grows to show it and a different rate is
+    offered (:attr:`Import.clip_fps`), not imposed."""
+    differs = rate is not None and abs(rate - doc.fps) > 1e-6
+    keep = _animated_elsewhere(doc) or end <= start
+    if rate is not None:  # a file's rounded frame time (0.0166667) must not add a frame
+        counted = rate if differs and not keep else doc.fps
+        if abs(end * counted - round(end * counted)) < 1e-3:
+            end = round(end * counted) / counted
+    if keep:
+        offer = None
+        if differs and end > start:
+            assert rate is not None
+            offer = rate
+            notes.append(f"The clip runs at {rate:g} fps, the project at {doc.fps:g} fps, so playback shows it "
+                         f"only at the project's frames; set the project to {rate:g} fps to see every frame.")
+        imp = _with_range(doc, add.text, add, end, asset_id, notes)
+        imp.clip_fps = offer
+        return imp
+    commands = [add]
+    fps = doc.fps
+    if differs:
+        assert rate is not None
+        commands.append(SetParameter(doc, "fps", int(rate) if rate.is_integer() else rate))
+        notes.append(f"Project frame rate set to the clip's {rate:g} fps (it was {doc.fps:g}).")
+        fps = rate
+    rng = clip_range_command(doc, start, end, fps)
+    if rng is not None:
+        commands.append(rng)
+        notes.append(f"Frame range set to the clip ({end - start:.3g} s).")
+    return Import(commands[0] if len(commands) == 1 else Macro(add.text, commands), asset_id, notes)
 
 
 def _asset_base(p: Path) -> str:
@@ -376,13 +439,8 @@ def gltf_import(doc: Document, path: str | os.PathLike[str]) -> Import:
     notes += place_new_character(doc, add, ch.clips[0].start if ch.clips else 0.0)
     if not ch.clips:
         return Import(add, aid, notes)
-    if _animated_elsewhere(doc):
-        return _with_range(doc, add.text, add, ch.clips[0].end, aid, notes)
-    rng = clip_range_command(doc, ch.clips[0].start, ch.clips[0].end)
-    if rng is None:
-        return Import(add, aid, notes)
-    notes.append("Frame range set to the clip.")
-    return Import(Macro(add.text, [add, rng]), aid, notes)
+    first = ch.clips[0]
+    return _timed(doc, add, first.start, first.end, _key_rate(first.channels.values()), aid, notes)
 
 
 # --------------------------------------------------------------------------- any

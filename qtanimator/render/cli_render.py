@@ -33,7 +33,8 @@ def _parser() -> argparse.ArgumentParser:
                                 description="Render a project or SVG character to PNG frames, a GIF or a video.")
     p.add_argument("scene", help="a project (.qtanim), an SVG character, or a folder of SVG characters")
     p.add_argument("-o", "--output", required=True,
-                   help="a folder, a pattern such as frames/frame_%%04d.png, a .gif or an .mp4")
+                   help="a folder, a pattern such as frames/frame_%%04d.png, a .gif (at most 50 fps: faster "
+                        "clips drop frames evenly, keeping the duration) or a video (.mp4, .mov, .mkv, .webm, .avi)")
     p.add_argument("--frames", help="frame range A:B (inclusive); the project's range by default")
     p.add_argument("--fps", type=float, help="frames per second (the project's by default)")
     p.add_argument("--size", default="960x640", help="image size WxH (default 960x640)")
@@ -100,9 +101,13 @@ def _ensure_gui_app() -> Any:
 
 
 class _Progress:
+    """A one-line progress bar redrawn with ``\\r``; quiet when stderr is not a terminal
+    (a log file or a pipe gets no bar, only the final summary)."""
+
     def __init__(self, total: int, enabled: bool) -> None:
         self.total = max(total, 1)
-        self.enabled = enabled
+        isatty = getattr(sys.stderr, "isatty", None)
+        self.enabled = enabled and bool(isatty and isatty())
 
     def __call__(self, done: int) -> None:
         if not self.enabled:
@@ -166,7 +171,24 @@ def _os_message(exc: OSError) -> str:
 
 
 def render_main(argv: Sequence[str]) -> int:
-    """Entry point of ``qtanimator render``; returns the exit status."""
+    """Entry point of ``qtanimator render``; returns the exit status.
+
+    SIGTERM / SIGINT end the render cleanly (temporary files removed, an existing GIF or
+    video left as it was, the private Xvfb stopped at exit) with status 128 + signal.
+    """
+    from qtanimator.render.interrupt import RenderInterrupted, interrupt_on_signals
+
+    try:
+        with interrupt_on_signals():
+            return _render_main(argv)
+    except RenderInterrupted as exc:
+        lead = "" if "--quiet" in argv else "\n"  # end the progress line
+        print(f"{lead}qtanimator render: stopped by {exc.name}; a GIF or video output was not written "
+              "(an existing file is left as it was)", file=sys.stderr)
+        return exc.exit_status
+
+
+def _render_main(argv: Sequence[str]) -> int:
     ns = _parser().parse_args(_negative_frames(argv))
     try:
         size = _parse_size(ns.size)
@@ -179,9 +201,12 @@ def render_main(argv: Sequence[str]) -> int:
         first, last = _parse_frames(ns.frames, doc.frame_range)
         fps = doc.fps
         times = [f / fps for f in range(first, last + 1)]
-        from qtanimator.render.export import output_kind, write_frames
+        from qtanimator.render.export import check_output, gif_timing_note, write_frames
 
-        output_kind(ns.output)
+        kind = check_output(ns.output)  # a bad format or an unwritable place fails before rendering
+        note = gif_timing_note(fps) if kind == "gif" else None
+        if note and not ns.quiet:
+            print(f"qtanimator render: {note}", file=sys.stderr)
         if ns.view == "3d":
             try:
                 from qtanimator.render import render3d

@@ -5,15 +5,23 @@ the 3D viewport and the GUI export dialog all share it. Formats by ``out``:
 
 * an existing folder, or a path without a suffix: ``out/frame_0000.png`` …;
 * a pattern with a ``%`` field such as ``shots/frame_%04d.png``;
-* ``*.gif`` (looping, transparency flattened onto white);
+* ``*.gif`` (looping, transparency flattened onto white). GIF frame delays are whole
+  centiseconds of at least 2, so a GIF plays at most 50 fps: faster clips are written at
+  50 fps with frames dropped evenly, and rates that are not 100/n fps get delays that
+  alternate (30 fps: 3, 3, 4 cs …); either way the total duration stays the clip's;
 * ``*.mp4`` / ``*.mov`` / ``*.mkv`` / ``*.webm`` / ``*.avi`` (H.264 or the container's
   default codec, odd sizes padded to even, transparency flattened onto white).
+
+Any other suffix is an error listing these formats (``check_output``, which also checks that
+the output location can be written before anything is rendered).
 """
 
 from __future__ import annotations
 
 import contextlib
+import errno
 import io
+import math
 import os
 import tempfile
 from collections.abc import Callable, Iterable, Iterator
@@ -30,6 +38,83 @@ VIDEO_SUFFIXES = {".mp4": "libx264", ".mov": "libx264", ".mkv": "libx264", ".avi
 IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}
 
 Frame = npt.NDArray[np.uint8]
+
+#: A GIF frame delay is a whole number of centiseconds; browsers play 0 or 1 cs as 10 cs.
+GIF_MIN_DELAY_CS = 2
+GIF_MAX_FPS = 100.0 / GIF_MIN_DELAY_CS
+FORMATS_HELP = ("a folder, a pattern such as frame_%04d.png, a .gif, or a video ("
+                + ", ".join(VIDEO_SUFFIXES) + ")")
+
+
+def gif_fps(fps: float) -> float:
+    """The frame rate a GIF of a ``fps`` clip is written at (at most 50)."""
+    return min(float(fps), GIF_MAX_FPS)
+
+
+def gif_timing_note(fps: float) -> str | None:
+    """One sentence on how a ``fps`` clip's GIF is timed, or None when every frame simply
+    gets the same whole-centisecond delay."""
+    if fps > GIF_MAX_FPS:
+        return (f"a GIF plays at most {GIF_MAX_FPS:g} fps (frame delays are whole centiseconds, at least 2): "
+                f"{fps:g} fps is written at {GIF_MAX_FPS:g} fps, dropping frames evenly; the duration is kept")
+    step = 100.0 / fps
+    if abs(step - round(step)) > 1e-9:
+        return (f"GIF frame delays are whole centiseconds: {fps:g} fps is written with delays of "
+                f"{math.floor(step)} and {math.ceil(step)} cs in turn; the duration is kept")
+    return None
+
+
+def _gif_cs(i: int, fps: float) -> int:
+    """The start of source frame ``i`` in whole centiseconds."""
+    return math.floor(i * 100.0 / fps + 0.5)
+
+
+def _gif_source_index(k: int, fps: float) -> int:
+    """The source frame shown as GIF frame ``k`` when ``fps`` is above what a GIF holds."""
+    return math.floor(k * fps / GIF_MAX_FPS + 1e-9)
+
+
+def gif_delays(n_source: int, kept: int, fps: float) -> list[int]:
+    """The delays (cs, each ≥ 2) of ``kept`` GIF frames made from ``n_source`` frames at ``fps``;
+    they add up to the clip's duration. May return fewer delays than ``kept`` (drop the rest)."""
+    total = max(_gif_cs(n_source, fps), GIF_MIN_DELAY_CS)
+    if fps <= GIF_MAX_FPS:
+        return [_gif_cs(i + 1, fps) - _gif_cs(i, fps) for i in range(kept)]
+    if kept <= 1:
+        return [total] * kept
+    delays = [GIF_MIN_DELAY_CS] * (kept - 1)
+    last = total - GIF_MIN_DELAY_CS * (kept - 1)
+    if last >= GIF_MIN_DELAY_CS:
+        return [*delays, last]
+    delays[-1] += max(last, 0)  # too short to show: fold it into the frame before
+    return delays
+
+
+def check_output(out: str | os.PathLike[str]) -> str:
+    """``output_kind(out)``, after checking that the output location can be written; raises
+    ValueError (a bad name or format) or OSError naming the real path. Creates nothing."""
+    kind = output_kind(out)
+    path = os.path.abspath(os.fspath(out))
+    if kind in ("gif", "video") and os.path.isdir(path):
+        raise IsADirectoryError(errno.EISDIR, "it is a folder", path)
+    folder = path if kind == "folder" else os.path.dirname(path)
+    probe = folder
+    while not os.path.lexists(probe):
+        parent = os.path.dirname(probe)
+        if parent == probe:
+            break
+        probe = parent
+    if not os.path.isdir(probe):
+        raise NotADirectoryError(errno.ENOTDIR, "not a folder", probe)
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise PermissionError(errno.EACCES, "Permission denied", probe)
+    try:  # os.access can say yes where a write fails (a read-only mount, root on a network share)
+        fd, tmp = tempfile.mkstemp(prefix=".qtanimator-write-check.", dir=probe)
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror, probe) from None
+    return kind
 
 
 def output_kind(out: str | os.PathLike[str]) -> str:
@@ -53,6 +138,8 @@ def output_kind(out: str | os.PathLike[str]) -> str:
         return "video"
     if suffix in IMAGE_SUFFIXES:
         raise ValueError(f"'{s}' names one image; give a folder or a pattern such as frame_%04d.png")
+    if suffix and not os.path.isdir(s):
+        raise ValueError(f"'{s}': unknown output format '{suffix}'; give {FORMATS_HELP}")
     return "folder"
 
 
@@ -109,7 +196,7 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
     """
     if not (fps > 0):
         raise ValueError("fps must be positive")
-    kind = output_kind(out)
+    kind = check_output(out)
     path = os.fspath(out)
     count = 0
     if kind in ("folder", "pattern"):
@@ -134,20 +221,30 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
 
         images: list[Image.Image] = []
         for a in _checked_frames(frames, progress, cancel):
-            images.append(Image.fromarray(flatten_alpha(a)).convert("P", palette=Image.Palette.ADAPTIVE))
+            # above 50 fps only the frames nearest a 2 cs grid are kept (dropped evenly)
+            if fps <= GIF_MAX_FPS or count == _gif_source_index(len(images), fps):
+                images.append(Image.fromarray(flatten_alpha(a)).convert("P", palette=Image.Palette.ADAPTIVE))
             count += 1
         if images:
+            delays = gif_delays(count, len(images), fps)
+            images = images[:len(delays)]
             buffer = io.BytesIO()
             images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:], loop=0,
-                           duration=max(int(round(1000.0 / fps)), 10), optimize=False)
-            write_atomic(path, buffer.getvalue())  # a failed export leaves the old file intact
+                           duration=[10 * d for d in delays], optimize=False)
+            try:
+                write_atomic(path, buffer.getvalue())  # a failed export leaves the old file intact
+            except OSError as exc:
+                raise _naming(exc, path) from None
         return count
     import imageio.v2 as iio2
 
     codec = VIDEO_SUFFIXES[Path(path).suffix.lower()]
     # ffmpeg writes a temporary file beside the target (same suffix: it picks the container
     # from it), which replaces the target only once the video is complete.
-    fd, tmp = tempfile.mkstemp(prefix=f".{Path(path).name}.", suffix=Path(path).suffix, dir=parent)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{Path(path).name}.", suffix=Path(path).suffix, dir=parent)
+    except OSError as exc:
+        raise _naming(exc, path) from None
     os.close(fd)
     writer = None
     done = False
@@ -164,6 +261,8 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
             writer = None
             _replace_keeping_mode(tmp, path)
             done = True
+    except OSError as exc:
+        raise _naming(exc, path, tmp) from None
     finally:
         if writer is not None:
             writer.close()
@@ -171,6 +270,16 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
             with contextlib.suppress(OSError):
                 os.unlink(tmp)
     return count
+
+
+def _naming(exc: OSError, path: str, tmp: str | None = None) -> OSError:
+    """``exc`` reported under the output's name instead of the hidden temporary file beside it."""
+    name = os.path.basename(str(exc.filename or ""))
+    if exc.filename is not None and (name.startswith(f".{Path(path).name}.") or name.startswith(".tmp")):
+        return OSError(exc.errno, exc.strerror, path)
+    if exc.filename is None and tmp and tmp in str(exc):
+        return OSError(str(exc).replace(tmp, path))
+    return exc
 
 
 def _replace_keeping_mode(tmp: str, target: str) -> None:

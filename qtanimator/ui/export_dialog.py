@@ -28,6 +28,7 @@ from PySide6.QtWidgets import (
     QFileDialog,
     QFormLayout,
     QHBoxLayout,
+    QLabel,
     QLineEdit,
     QProgressDialog,
     QPushButton,
@@ -174,6 +175,10 @@ class ExportDialog(QDialog):
         range_row.addWidget(self.first_box)
         range_row.addWidget(self.last_box)
         form.addRow("Frames", range_row)
+        self.gif_note = QLabel(self)
+        self.gif_note.setObjectName("exportGifNote")
+        self.gif_note.setWordWrap(True)
+        form.addRow(self.gif_note)
         buttons = QDialogButtonBox(QDialogButtonBox.StandardButton.Ok | QDialogButtonBox.StandardButton.Cancel,
                                    self)
         buttons.button(QDialogButtonBox.StandardButton.Ok).setText("Export")
@@ -181,6 +186,17 @@ class ExportDialog(QDialog):
         buttons.rejected.connect(self.reject)
         form.addRow(buttons)
         self.format_box.currentIndexChanged.connect(self._format_changed)
+        self.format_box.currentIndexChanged.connect(self._update_gif_note)
+        self.fps_box.valueChanged.connect(self._update_gif_note)
+        self._update_gif_note()
+
+    def _update_gif_note(self) -> None:
+        """Say at what rate a GIF is written (a GIF holds at most 50 fps, in whole centiseconds)."""
+        from qtanimator.render.export import gif_timing_note
+
+        note = gif_timing_note(self.fps_box.value()) if self.format_box.currentData() == "gif" else None
+        self.gif_note.setText(note[0].upper() + note[1:] + "." if note else "")
+        self.gif_note.setVisible(bool(note))
 
     def _format_changed(self) -> None:
         fmt = self.format_box.currentData()

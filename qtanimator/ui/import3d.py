@@ -5,7 +5,9 @@ Openers for ``.skel``, ``.skin``, ``.anim``, ``.obj``, ``.bvh``, ``.glb`` and ``
 :func:`qtanimator.document.import3d.import_file` builds (a FormatError leaves the document as
 it is and :meth:`MainWindow.open_path` shows it), selects the character, switches to the
 "3D" tab and frames it. Notes about the import (companion files picked up, approximations)
-go to the status bar and :attr:`MainWindow.last_import_notes`.
+go to the status bar and :attr:`MainWindow.last_import_notes`. A clip whose frame rate differs
+from a project that already has keys brings a status-bar button (``adoptClipFps``) that sets
+the project to the clip's rate (:func:`offer_fps`).
 """
 
 from __future__ import annotations
@@ -14,16 +16,19 @@ import os
 from pathlib import Path
 from typing import Any
 
+from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QFileDialog, QMessageBox
+from PySide6.QtWidgets import QFileDialog, QMessageBox, QPushButton
 
-from qtanimator.document.character3d import ASSET_KIND
+from qtanimator.document.character3d import ASSET_KIND, set_fps_command
 from qtanimator.document.import3d import SUFFIXES, export_gltf, import_file, target_character
 from qtanimator.formats.errors import FormatError
 
 GLTF_FILTER = "glTF binary (*.glb)"
+#: How long the status-bar offer to take an imported clip's frame rate stays (ms).
+OFFER_MS = 60000
 
-__all__ = ["export_gltf_dialog", "export_gltf_to", "install", "open_3d", "show_character"]
+__all__ = ["export_gltf_dialog", "export_gltf_to", "install", "offer_fps", "open_3d", "show_character"]
 
 
 def open_3d(window: Any, path: Path) -> None:
@@ -38,7 +43,39 @@ def open_3d(window: Any, path: Path) -> None:
     window.last_import_notes = list(result.notes)
     if result.notes:
         window.statusBar().showMessage(f"{Path(path).name}: {' '.join(result.notes)}", 15000)
+    offer_fps(window, result.clip_fps)
     show_character(window, result.asset_id)
+
+
+def offer_fps(window: Any, fps: float | None) -> None:
+    """Show (or with None take away) a status-bar button that sets the project's frame rate
+    to an imported clip's (one undo step, the frame range's seconds kept). Non-modal: it goes
+    away when used, on the next import, or after :data:`OFFER_MS`."""
+    old = getattr(window, "fps_offer_button", None)
+    if old is not None:
+        window.statusBar().removeWidget(old)
+        old.deleteLater()
+        window.fps_offer_button = None
+    if fps is None:
+        return
+    button = QPushButton(f"Set project to {fps:g} fps", window)
+    button.setObjectName("adoptClipFps")
+    button.setToolTip("Play the imported clip at its own frame rate (keys stay in time; the frame range keeps "
+                      "its seconds)")
+
+    def adopt() -> None:
+        if window.fps_offer_button is button:
+            window.ctx.push(set_fps_command(window.doc, fps))
+            offer_fps(window, None)
+
+    def expire() -> None:
+        if window.fps_offer_button is button:
+            offer_fps(window, None)
+
+    button.clicked.connect(adopt)
+    window.statusBar().addPermanentWidget(button)
+    window.fps_offer_button = button
+    QTimer.singleShot(OFFER_MS, expire)
 
 
 def show_character(window: Any, asset_id: str) -> None:
@@ -110,6 +147,7 @@ def install(window: Any) -> None:
         window.openers[suffix] = open_3d
     window.last_import_notes = []
     window.last_export_warnings = []
+    window.fps_offer_button = None
     action = QAction("Export &glTF…", window)
     action.setObjectName("actionExportGltf")
     action.setToolTip("Export the selected 3D character and its animation as a .glb file")

@@ -195,3 +195,26 @@ def test_opened_character_is_framed_in_the_3d_view(qtbot, shared_data, dialog_lo
     rows = np.flatnonzero(changed.any(axis=1))
     assert (rows[-1] - rows[0]) > 0.4 * changed.shape[0]
     assert view.last_error == ""
+
+
+def test_a_clip_at_another_rate_is_offered_in_the_status_bar(window, tmp_path, dialog_log):
+    from PySide6.QtWidgets import QPushButton
+
+    from tests.document.test_import_timing import write_bvh
+
+    doc = window.doc
+    doc.apply_channel("other/j/x", _two_keys())  # a document with keys: the rate is only offered
+    assert window.open_path(write_bvh(tmp_path / "fast.bvh", 121))
+    assert doc.fps == 60 and dialog_log == []
+    button = window.statusBar().findChild(QPushButton, "adoptClipFps")
+    assert button is not None and "120" in button.text()
+    count = window.ctx.undo_stack.count()
+    button.click()
+    assert doc.fps == 120 and window.ctx.undo_stack.count() == count + 1
+    assert window.fps_offer_button is None
+
+
+def _two_keys():
+    from qtanimator.core.channel import Channel, Key
+
+    return Channel([Key(0.0, 0.0), Key(1.0, 1.0)])

@@ -1,0 +1,65 @@
+"""Clean exits from a render: SIGTERM and SIGINT become an exception.
+
+Python's default SIGTERM ends the process at once, so ``finally`` blocks, context managers
+and ``atexit`` never run: a partial temporary video stays beside the output and the private
+Xvfb (:mod:`qtanimator.render.xvfb`) outlives its parent. Inside :func:`interrupt_on_signals`
+both signals raise :class:`RenderInterrupted` in the main thread instead, so the writers
+remove their temporary files (the existing output is never replaced) and the process exits
+normally, which stops the Xvfb. Imports no Qt.
+"""
+
+from __future__ import annotations
+
+import signal
+import threading
+from collections.abc import Iterator
+from contextlib import contextmanager
+from types import FrameType
+
+HANDLED = (signal.SIGTERM, signal.SIGINT)
+
+
+class RenderInterrupted(KeyboardInterrupt):
+    """A render ended by a signal. A KeyboardInterrupt (not an Exception), so ``except
+    Exception`` does not swallow it while ``finally`` and ``except BaseException`` clean up."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
+
+    @property
+    def name(self) -> str:
+        return signal.Signals(self.signum).name
+
+    @property
+    def exit_status(self) -> int:
+        """``128 + signal``, as a shell reports a process ended by that signal."""
+        return 128 + self.signum
+
+
+@contextmanager
+def interrupt_on_signals() -> Iterator[None]:
+    """SIGTERM / SIGINT raise :class:`RenderInterrupted` while the block runs.
+
+    Only the first signal raises; later ones are ignored so they cannot break the cleanup
+    that the first one started. The previous handlers come back afterwards. Outside the
+    main thread (where Python cannot set handlers) the block runs unchanged.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    fired = False
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        nonlocal fired
+        if fired:
+            return
+        fired = True
+        raise RenderInterrupted(signum)
+
+    previous = {s: signal.signal(s, handler) for s in HANDLED}
+    try:
+        yield
+    finally:
+        for s, old in previous.items():
+            signal.signal(s, old if old is not None else signal.SIG_DFL)
