@@ -75,7 +75,12 @@ def offer_fps(window: Any, fps: float | None) -> None:
     button.clicked.connect(adopt)
     window.statusBar().addPermanentWidget(button)
     window.fps_offer_button = button
-    QTimer.singleShot(OFFER_MS, expire)
+    # The timer belongs to the button: it dies with it (used, replaced, or the window closed),
+    # so it never fires into a deleted window.
+    timer = QTimer(button)
+    timer.setSingleShot(True)
+    timer.timeout.connect(expire)
+    timer.start(OFFER_MS)
 
 
 def show_character(window: Any, asset_id: str) -> None:

@@ -218,3 +218,19 @@ def _two_keys():
     from qtanimator.core.channel import Channel, Key
 
     return Channel([Key(0.0, 0.0), Key(1.0, 1.0)])
+
+
+def test_the_rate_offer_expiring_after_its_window_closed_raises_nothing(qtbot, monkeypatch, tmp_path):
+    """The offer's expiry timer once fired into a deleted window (RuntimeError in the Qt event
+    loop, seen in CI): it now belongs to the button and dies with the window."""
+    from qtanimator.ui import import3d as ui_import3d
+    from qtanimator.ui.main_window import MainWindow
+
+    monkeypatch.setattr(ui_import3d, "OFFER_MS", 50)
+    w = MainWindow(install_editors=False)
+    w.show()
+    ui_import3d.offer_fps(w, 120.0)
+    assert w.fps_offer_button is not None
+    w.close()
+    w.deleteLater()
+    qtbot.wait(200)  # past the expiry: pytest-qt fails the test on an exception in the event loop
