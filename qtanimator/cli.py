@@ -1,4 +1,5 @@
-"""Command line: ``qtanimator [PATH]``, ``qtanimator render …``, ``qtanimator info …``.
+"""Command line: ``qtanimator [PATH]``, ``qtanimator render …``, ``qtanimator export …``,
+``qtanimator info …``.
 
 Bad input gives a one-line error on stderr and a non-zero exit status, never a traceback.
 Set ``QTANIMATOR_DEBUG=1`` to get the traceback of an unexpected error instead.
@@ -51,6 +52,10 @@ def main(argv: Sequence[str] | None = None) -> int:
             return _info(args[1:])
         if args and args[0] == "render":
             return _render(args[1:])
+        if args and args[0] == "export":
+            from qtanimator.cli_export import export_main
+
+            return int(export_main(args[1:]))
         return _gui(args)
     except SystemExit as exc:  # argparse: --help, --version and usage errors
         return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else EXIT_USAGE)
@@ -110,6 +115,7 @@ def _gui(args: list[str]) -> int:
         description="Character animation: 2D SVG rigs with IK and pendulums, a curve editor, "
                     "skinned 3D characters and cloth.",
         epilog="Subcommands: 'qtanimator render --help' renders without a window; "
+               "'qtanimator export --help' writes a 3D character as glTF; "
                "'qtanimator info --help' summarises a file. "
                f"The log file is {applog.log_path()}.",
     )

@@ -103,7 +103,7 @@ def _small(args: list[str], tmp_path: Path) -> list[str]:
         target = tmp_path / "folder"
     first = int(ns.frames.split(":")[0]) if ns.frames else 0
     small = [ns.scene, "-o", str(target), "--frames", f"{first}:{first + 1}", "--size", "64x48", "--quiet",
-             "--view", ns.view, "--background", ns.background]
+             "--view", ns.view] + (["--background", ns.background] if ns.background is not None else [])
     return small + (["--fps", str(ns.fps)] if ns.fps else [])
 
 
@@ -120,6 +120,12 @@ def test_command_line_in_the_docs_runs(args: list[str], tmp_path: Path, qapp, mo
     from qtanimator.cli import main
 
     monkeypatch.chdir(REPO)
+    if args[:1] == ["export"]:
+        out = tmp_path / "out.glb"
+        i = args.index("-o")
+        assert main([*args[:i + 1], str(out), *args[i + 2:]]) == 0
+        assert out.read_bytes()[:4] == b"glTF"
+        return
     if not args or args[0] not in ("render", "info"):
         # ``qtanimator [PATH]`` opens the GUI: only check what it would open.
         assert not args or Path(args[0]).exists() or args[0].startswith("-"), args

@@ -892,6 +892,32 @@ class PendulumCache:
         sim = self._sims.get(asset_id)
         return 0 if sim is None else len(sim.theta)
 
+    def baked_states(self) -> dict[str, tuple[FloatArray, FloatArray, PendulumBlowUp | None]]:
+        """Every character's cached frames as ``{asset: (theta (F, J), omega (F, J), problem)}``:
+        plain arrays that pickle, for :meth:`load_baked_states` in another process (the
+        parallel render bakes the pendulums once and hands them to its workers)."""
+        with self._lock:
+            out: dict[str, tuple[FloatArray, FloatArray, PendulumBlowUp | None]] = {}
+            for aid, sim in self._sims.items():
+                if sim.theta:
+                    out[aid] = (np.array(sim.theta), np.array(sim.omega), sim.problem)
+            return out
+
+    def load_baked_states(self, states: dict[str, tuple[FloatArray, FloatArray, PendulumBlowUp | None]]) -> None:
+        """Put frames from :meth:`baked_states` (of the same document) into this cache; reads
+        of those frames then never simulate."""
+        doc = self._doc()
+        if doc is None:
+            raise RuntimeError("the document is gone")
+        for aid, (theta, omega, problem) in states.items():
+            sim = _new_sim(doc, aid, character(doc, aid))
+            sim.theta = [np.array(row) for row in theta]
+            sim.omega = [np.array(row) for row in omega]
+            sim.problem = problem
+            with self._lock:
+                self._sims[aid] = sim
+                self.revision += 1
+
     # ---- exact reads
     def _sim(self, doc: Document, asset_id: str) -> _AssetSim:
         while True:

@@ -1,7 +1,8 @@
 """``qtanimator render SCENE -o OUT``: render without a window.
 
-SCENE is a project (``.qtanim``) or an SVG character file or folder. OUT is a folder, a
-``frame_%04d.png`` pattern, a ``.gif`` or a video (``.mp4``). Dynamic joints are simulated
+SCENE is any file the program opens: a project (``.qtanim``), an SVG character file or folder,
+or a 3D file (``.skel``, ``.bvh``, ``.glb`` …, imported into a new document as File ▸ Open does).
+OUT is a folder, a ``frame_%04d.png`` pattern, a ``.gif`` or a video (``.mp4``). Dynamic joints are simulated
 (the pendulum cache steps forward frame by frame). The camera is fixed: the union of the
 scene's bounds over the rendered frames, fitted into ``--size``.
 """
@@ -31,19 +32,27 @@ class _OneLineParser(argparse.ArgumentParser):
 def _parser() -> argparse.ArgumentParser:
     p = _OneLineParser(prog="qtanimator render",
                                 description="Render a project or SVG character to PNG frames, a GIF or a video.")
-    p.add_argument("scene", help="a project (.qtanim), an SVG character, or a folder of SVG characters")
+    p.add_argument("scene", help="a project (.qtanim), an SVG character, a folder of SVG characters, or a 3D "
+                                 "file (.skel, .skin, .anim, .obj, .bvh, .glb, .gltf)")
     p.add_argument("-o", "--output", required=True,
                    help="a folder, a pattern such as frames/frame_%%04d.png, a .gif (at most 50 fps: faster "
                         "clips drop frames evenly, keeping the duration) or a video (.mp4, .mov, .mkv, .webm, .avi)")
     p.add_argument("--frames", help="frame range A:B (inclusive); the project's range by default")
     p.add_argument("--fps", type=float, help="frames per second (the project's by default)")
     p.add_argument("--size", default="960x640", help="image size WxH (default 960x640)")
-    p.add_argument("--background", default="white",
-                   help="a colour name or #rrggbb, or 'transparent' (default white)")
+    p.add_argument("--background",
+                   help="a colour name or #rrggbb, or 'transparent' (default: white in 2D, the viewport's "
+                        "grey in 3D)")
     p.add_argument("--view", choices=("auto", "2d", "3d"), default="auto",
                    help="the 2D renderer or the 3D viewport (default: 2d when the scene has 2D "
                         "characters, else 3d)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--jobs", type=int,
+                   help="2D: render in N processes (default 1: the frames are still encoded here, so "
+                        "extra processes pay off only with many cores); the pendulums are simulated once, here")
+    p.add_argument("--dask", metavar="ADDRESS",
+                   help="2D: render on a Dask distributed cluster (scheduler address such as "
+                        "tcp://host:8786; needs the 'dask' extra)")
     return p
 
 
@@ -72,7 +81,8 @@ def _parse_frames(text: str | None, default: tuple[int, int]) -> tuple[int, int]
 
 
 def load_scene(path: str | os.PathLike[str]) -> Any:
-    """A document for a project or an SVG character / folder."""
+    """A document for any file the program opens: a project, an SVG character / folder, or a
+    3D file (``.skel``, ``.bvh``, ``.glb`` …, imported into a new document)."""
     from qtanimator.document import Document, open_document
 
     p = Path(path)
@@ -87,8 +97,16 @@ def load_scene(path: str | os.PathLike[str]) -> Any:
         add_characters_command(doc, p, new_project_range=True).do(doc)  # 0…300, as opening it in the GUI
         doc.path = None
         return doc
-    raise FormatError(f"qtanimator render reads projects (.qtanim) and SVG characters, not "
-                      f"'{p.suffix}' files.", p)
+    from qtanimator.document.import3d import SUFFIXES, import_file
+
+    if p.is_file() and p.suffix.lower() in SUFFIXES:
+        # as File ▸ Open does: a new document with the file imported (its clip's frame range and fps)
+        doc = Document()
+        import_file(doc, p).command.do(doc)
+        doc.path = None
+        return doc
+    raise FormatError(f"qtanimator reads projects (.qtanim), SVG characters and 3D files "
+                      f"({', '.join(SUFFIXES)}), not '{p.suffix}' files.", p)
 
 
 def _ensure_gui_app() -> Any:
@@ -127,6 +145,38 @@ def frames_2d(doc: Any, times: Sequence[float], size: tuple[int, int], backgroun
     view = animation_bounds(doc, times)
     for t in times:
         yield image_to_array(render_frame(doc, t, size, background, view=view))
+
+
+def options_3d(background: str | None) -> Any:
+    """The 3D view options of a render: no skeleton, no light markers, ``background`` (a colour
+    name, #rrggbb or 'transparent'; None: the viewport's)."""
+    from qtanimator.render.gl.renderer import ViewOptions
+    from qtanimator.render.painter2d import background_color
+
+    options = ViewOptions(show_skeleton=False, show_lights=False)
+    if background is not None:
+        c = background_color(background)  # ValueError for a bad colour
+        options.background = (c.redF(), c.greenF(), c.blueF(), c.alphaF())
+        if c.alpha() == 0:
+            options.show_grid = False  # a transparent render is for compositing: no floor grid
+    return options
+
+
+def _frames_2d_any(ns: argparse.Namespace, doc: Any, times: Sequence[float], size: tuple[int, int],
+                   background: str) -> Iterator[np.ndarray]:
+    """:func:`frames_2d` in this process, in ``--jobs`` processes or on a ``--dask`` cluster."""
+    from qtanimator.render import parallel
+
+    if ns.jobs is not None and ns.jobs < 1:
+        raise ValueError("--jobs must be at least 1")
+    if ns.dask:
+        return parallel.frames_2d_dask(ns.scene, doc, times, size, background, ns.dask)
+    # One process unless asked: on the 2-core machine measured, two processes were slower
+    # (0.75x), because the parent still encodes every frame (benchmarks/bench_render_jobs.py).
+    jobs = ns.jobs if ns.jobs is not None else 1
+    if jobs > 1 and len(times) > 1:
+        return parallel.frames_2d_jobs(ns.scene, doc, times, size, background, jobs)
+    return frames_2d(doc, times, size, background)
 
 
 _KINDS_2D = ("character2d",)
@@ -220,11 +270,14 @@ def _render_main(argv: Sequence[str]) -> int:
             _ensure_gui_app()
         from qtanimator.render.painter2d import background_color
 
-        background_color(ns.background)
+        if ns.background is not None:
+            background_color(ns.background)  # a bad colour fails before rendering
+        if ns.view == "3d" and (ns.dask or (ns.jobs or 1) > 1):
+            raise ValueError("--jobs and --dask render 2D views; the 3D view renders in one process")
         if ns.view == "3d":
-            frames: Any = render_frames_3d(doc, times, size)
+            frames: Any = render_frames_3d(doc, times, size, options=options_3d(ns.background))
         else:
-            frames = frames_2d(doc, times, size, ns.background)
+            frames = _frames_2d_any(ns, doc, times, size, "white" if ns.background is None else ns.background)
         progress = _Progress(len(times), not ns.quiet)
         n = write_frames(frames, ns.output, fps, progress=progress, start=first)
     except (FormatError, ValueError) as exc:

@@ -1,16 +1,19 @@
-"""File > Export Animation…: a PNG sequence, a GIF or an MP4 of the 2D scene.
+"""File > Export Animation…: a PNG sequence, a GIF or an MP4 of the 2D or 3D view, or a glTF file.
 
 File > Export Image Sequence… (``Ctrl+Shift+E``, the CMU animator's ``s``) opens the same
 dialog set to PNG frames.
 
-The dialog picks the format, the output, the image size, the frame rate and the frame
-range; the frames are rendered with the shared 2D renderer and written by
+The dialog picks the view (the 2D view; the 3D view as the viewport shows it: its camera, the
+lights, cloth; or the selected 3D character as a glTF file, written as File > Export glTF does),
+the format, the output, the image size, the frame rate and the frame range; the frames are
+rendered with the shared 2D or 3D renderer (as ``qtanimator render``) and written by
 ``qtanimator.render.export.write_frames`` while a QProgressDialog shows progress and
 offers Cancel.
 """
 
 from __future__ import annotations
 
+import copy
 import inspect
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
@@ -47,7 +50,14 @@ FORMATS = {
     "mp4": ("MP4 video (H.264)", ".mp4"),
 }
 
-#: The reference program's export background (0.6, 0.6, 0.95).
+#: What the export shows: its label and the ``qtanimator`` command that does the same.
+VIEWS = {
+    "2d": "2D view",
+    "3d": "3D view",
+    "gltf": "glTF file (.glb)",
+}
+
+#: The reference program's export background (0.6, 0.6, 0.95) (2D; 3D keeps the viewport's).
 DEFAULT_BACKGROUND = QColor(153, 153, 242)
 
 
@@ -63,18 +73,32 @@ class ExportSettings:
     first: int = 0
     last: int = 240
     background: QColor | None = None
+    #: "2d", "3d" or "gltf" (see :data:`VIEWS`)
+    view: str = "2d"
+    #: the 3D view's camera (an OrbitCamera; None: framed as ``qtanimator render`` does)
+    camera: Any = None
+
+
+def default_view(doc: Document) -> str:
+    """2D when the scene has 2D characters, else 3D when it has 3D characters or cloth."""
+    kinds = {a.kind for a in doc.assets.values()}
+    if "character2d" not in kinds and kinds & {"character3d", "cloth"}:
+        return "3d"
+    return "2d"
 
 
 def default_settings(doc: Document) -> ExportSettings:
     first, last = doc.frame_range
     base = Path(doc.path).with_suffix("") if doc.path else Path.cwd() / "animation"
     return ExportSettings(out=str(base.parent / f"{base.name}_frames"), fmt="png", fps=doc.fps,
-                          first=first, last=last)
+                          first=first, last=last, view=default_view(doc))
 
 
 def output_target(settings: ExportSettings) -> str:
     """The path ``write_frames`` receives: the extension decides the format."""
     out = settings.out
+    if settings.view == "gltf":
+        return out if out.lower().endswith(".glb") else out + ".glb"
     if settings.fmt == "png":
         return out
     suffix = FORMATS[settings.fmt][1]
@@ -83,11 +107,15 @@ def output_target(settings: ExportSettings) -> str:
 
 def render_frames(doc: Document, settings: ExportSettings) -> Iterator[Any]:
     """RGBA arrays of the range, rendered in order (so pendulums simulate forward), with
-    one camera for the whole range (the union of the characters' bounds)."""
+    one camera for the whole range (the union of the characters' bounds; in 3D the settings'
+    camera)."""
     from qtanimator.render.painter2d import animation_bounds, image_to_array, render_frame
 
-    background = settings.background or DEFAULT_BACKGROUND
     frames = list(range(settings.first, settings.last + 1))
+    if settings.view == "3d":
+        yield from _render_frames_3d(doc, settings, frames)
+        return
+    background = settings.background or DEFAULT_BACKGROUND
     sample = frames[::max(len(frames) // 24, 1)] + frames[-1:]
     view = animation_bounds(doc, [doc.frame_to_time(f) for f in sample])
     size = (settings.width, settings.height)
@@ -95,6 +123,19 @@ def render_frames(doc: Document, settings: ExportSettings) -> Iterator[Any]:
         image = render_frame(doc, doc.frame_to_time(frame), size, background,
                              view=view if not view.isEmpty() else None)
         yield image_to_array(image)
+
+
+def _render_frames_3d(doc: Document, settings: ExportSettings, frames: list[int]) -> Iterator[Any]:
+    from qtanimator.render.gl.renderer import ViewOptions
+    from qtanimator.render.render3d import render_frames_3d
+
+    options = ViewOptions(show_skeleton=False, show_lights=False)
+    if settings.background is not None:
+        c = settings.background
+        options.background = (c.redF(), c.greenF(), c.blueF(), c.alphaF())
+    camera = copy.deepcopy(settings.camera) if settings.camera is not None else None
+    yield from render_frames_3d(doc, [doc.frame_to_time(f) for f in frames], (settings.width, settings.height),
+                                camera=camera, options=options)
 
 
 def _call_progress(progress: Callable[[int, int], bool] | None, done: int, total: int) -> bool:
@@ -144,6 +185,14 @@ class ExportDialog(QDialog):
         self.setWindowTitle("Export Animation")
         s = initial or default_settings(doc)
         form = QFormLayout(self)
+        self.view_box = QComboBox(self)
+        self.view_box.setObjectName("exportView")
+        self.view_box.setToolTip("The 2D view, the 3D view (with the viewport's camera, the lights and cloth), "
+                                 "or the selected 3D character and its animation as a glTF file")
+        for key, label in VIEWS.items():
+            self.view_box.addItem(label, key)
+        self.view_box.setCurrentIndex(list(VIEWS).index(s.view if s.view in VIEWS else "2d"))
+        form.addRow("View", self.view_box)
         self.format_box = QComboBox(self)
         self.format_box.setObjectName("exportFormat")
         for key, (label, _suffix) in FORMATS.items():
@@ -185,6 +234,10 @@ class ExportDialog(QDialog):
         buttons.accepted.connect(self.accept)
         buttons.rejected.connect(self.reject)
         form.addRow(buttons)
+        self.image_widgets = [self.format_box, self.width_box, self.height_box, self.fps_box, self.first_box,
+                              self.last_box]
+        self.view_box.currentIndexChanged.connect(self._view_changed)
+        self._view_changed()
         self.format_box.currentIndexChanged.connect(self._format_changed)
         self.format_box.currentIndexChanged.connect(self._update_gif_note)
         self.fps_box.valueChanged.connect(self._update_gif_note)
@@ -194,22 +247,36 @@ class ExportDialog(QDialog):
         """Say at what rate a GIF is written (a GIF holds at most 50 fps, in whole centiseconds)."""
         from qtanimator.render.export import gif_timing_note
 
-        note = gif_timing_note(self.fps_box.value()) if self.format_box.currentData() == "gif" else None
+        gif = self.format_box.currentData() == "gif" and self.view_box.currentData() != "gltf"
+        note = gif_timing_note(self.fps_box.value()) if gif else None
         self.gif_note.setText(note[0].upper() + note[1:] + "." if note else "")
         self.gif_note.setVisible(bool(note))
+
+    def _view_changed(self) -> None:
+        """glTF has no images: the image settings are off and the output becomes a .glb."""
+        gltf = self.view_box.currentData() == "gltf"
+        for widget in self.image_widgets:
+            widget.setEnabled(not gltf)
+        self._format_changed()
+        self._update_gif_note()
 
     def _format_changed(self) -> None:
         fmt = self.format_box.currentData()
         out = self.path_edit.text()
         stem = out
-        for _label, suffix in FORMATS.values():
+        for suffix in [s for _label, s in FORMATS.values()] + [".glb"]:
             if suffix and stem.lower().endswith(suffix):
                 stem = stem[: -len(suffix)]
-        self.path_edit.setText(stem + FORMATS[fmt][1])
+        if self.view_box.currentData() == "gltf":
+            self.path_edit.setText(stem + ".glb")
+        else:
+            self.path_edit.setText(stem + FORMATS[fmt][1])
 
     def _browse(self) -> None:
         fmt = self.format_box.currentData()
-        if fmt == "png":
+        if self.view_box.currentData() == "gltf":
+            path, _ = QFileDialog.getSaveFileName(self, "Export to", self.path_edit.text(), "glTF binary (*.glb)")
+        elif fmt == "png":
             path = QFileDialog.getExistingDirectory(self, "Folder for the frames", self.path_edit.text())
         else:
             suffix = FORMATS[fmt][1]
@@ -222,7 +289,8 @@ class ExportDialog(QDialog):
         return ExportSettings(out=self.path_edit.text(), fmt=str(self.format_box.currentData()),
                               width=self.width_box.value(), height=self.height_box.value(),
                               fps=self.fps_box.value(), first=self.first_box.value(),
-                              last=max(self.last_box.value(), self.first_box.value()))
+                              last=max(self.last_box.value(), self.first_box.value()),
+                              view=str(self.view_box.currentData()))
 
 
 def _spin(parent: QWidget, name: str, lo: int, hi: int, value: int) -> QSpinBox:
@@ -234,7 +302,12 @@ def _spin(parent: QWidget, name: str, lo: int, hi: int, value: int) -> QSpinBox:
 
 
 def run_export(window: MainWindow, settings: ExportSettings) -> int:
-    """Export with a progress dialog (Cancel stops after the current frame)."""
+    """Export with a progress dialog (Cancel stops after the current frame); a glTF file as
+    File > Export glTF does (1 when written)."""
+    if settings.view == "gltf":
+        from qtanimator.ui.import3d import export_gltf_to
+
+        return 1 if export_gltf_to(window, output_target(settings)) else 0
     total = max(settings.last - settings.first + 1, 1)
     dialog = QProgressDialog("Exporting animation…", "Cancel", 0, total, window)
     dialog.setObjectName("exportProgress")
@@ -267,12 +340,20 @@ def run_export(window: MainWindow, settings: ExportSettings) -> int:
     return written
 
 
+def viewport_camera(window: Any) -> Any:
+    """A copy of the 3D viewport's camera (None when the window has no 3D view)."""
+    view = getattr(window, "viewport3d", None)
+    camera = getattr(view, "camera", None)
+    return copy.deepcopy(camera) if camera is not None else None
+
+
 def open_export_dialog(window: MainWindow) -> int:
     previous = getattr(window, "export_settings", None)
     dialog = ExportDialog(window.doc, window, previous)
     if dialog.exec() != QDialog.DialogCode.Accepted:
         return 0
     settings = dialog.settings()
+    settings.camera = viewport_camera(window)
     window.export_settings = settings  # type: ignore[attr-defined]
     return run_export(window, settings)
 
@@ -283,11 +364,12 @@ def image_sequence_settings(window: MainWindow) -> ExportSettings:
     from dataclasses import replace
 
     previous = getattr(window, "export_settings", None)
-    if isinstance(previous, ExportSettings) and previous.fmt == "png":
+    if isinstance(previous, ExportSettings) and previous.fmt == "png" and previous.view != "gltf":
         return previous
     defaults = default_settings(window.doc)
     if isinstance(previous, ExportSettings):
-        return replace(previous, fmt="png", out=defaults.out)
+        view = defaults.view if previous.view == "gltf" else previous.view
+        return replace(previous, fmt="png", out=defaults.out, view=view)
     return defaults
 
 
@@ -298,6 +380,7 @@ def open_image_sequence_dialog(window: MainWindow) -> int:
     if dialog.exec() != QDialog.DialogCode.Accepted:
         return 0
     settings = dialog.settings()
+    settings.camera = viewport_camera(window)
     window.export_settings = settings  # type: ignore[attr-defined]
     return run_export(window, settings)
 
