@@ -61,7 +61,14 @@ import qtanimator
 from qtanimator import paths
 
 gif = Image.open(sys.argv[1])
-assert gif.format == "GIF" and gif.size == (240, 160) and gif.n_frames == 13, (gif.format, gif.size, gif.n_frames)
+# 13 frames of the 60 fps demo: a GIF holds at most 50 fps (2 cs delays), so one frame in six is
+# dropped evenly and the duration kept (issue 15): 11 frames, 13/60 s in all.
+durations = []
+for i in range(gif.n_frames):
+    gif.seek(i)
+    durations.append(gif.info["duration"])
+assert gif.format == "GIF" and gif.size == (240, 160) and gif.n_frames == 11, (gif.format, gif.size, gif.n_frames)
+assert min(durations) >= 20 and abs(sum(durations) - 1000 * 13 / 60) <= 10, durations
 package = Path(qtanimator.__file__).resolve().parent
 assert "site-packages" in package.parts, package
 for path in (paths.shader_path("mesh.vert"), paths.app_icon_path(), paths.demo_project(),
@@ -73,6 +80,6 @@ dist = metadata.distribution("qtanimator")
 assert dist.metadata["License-Expression"] == "MIT"
 assert any(str(f).endswith("licenses/LICENSE") for f in dist.files or []), "no LICENSE in the dist-info"
 assert find_spec("numba") is None, "numba is the [fast] extra, not a dependency"
-print("wheel_check: GIF of 13 frames, data files, LICENSE present; numba not installed")
+print("wheel_check: GIF of 11 frames (13 at 60 fps), data files, LICENSE present; numba not installed")
 PY
 say "ok"
