@@ -48,8 +48,8 @@ def _parser() -> argparse.ArgumentParser:
                         "characters, else 3d)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--jobs", type=int,
-                   help="2D: render in N processes (default 1: the frames are still encoded here, so "
-                        "extra processes pay off only with many cores); the pendulums are simulated once, here")
+                   help="2D: render in N processes (default: all cores for 120 PNG frames or more, else 1); "
+                        "the pendulums are simulated once, here")
     p.add_argument("--dask", metavar="ADDRESS",
                    help="2D: render on a Dask distributed cluster (scheduler address such as "
                         "tcp://host:8786; needs the 'dask' extra)")
@@ -169,13 +169,19 @@ def _frames_2d_any(ns: argparse.Namespace, doc: Any, times: Sequence[float], siz
 
     if ns.jobs is not None and ns.jobs < 1:
         raise ValueError("--jobs must be at least 1")
+    # PNG frames are encoded by the workers (the parent only writes the bytes); a GIF or a
+    # video needs the raw frames in the parent.
+    from qtanimator.render.export import output_kind
+
+    encode = output_kind(ns.output) in ("folder", "pattern")
     if ns.dask:
-        return parallel.frames_2d_dask(ns.scene, doc, times, size, background, ns.dask)
-    # One process unless asked: on the 2-core machine measured, two processes were slower
-    # (0.75x), because the parent still encodes every frame (benchmarks/bench_render_jobs.py).
-    jobs = ns.jobs if ns.jobs is not None else 1
+        return parallel.frames_2d_dask(ns.scene, doc, times, size, background, ns.dask, encode=encode)
+    # By default all cores for PNG frames (encoded by the workers: 1.5-1.7x on 2 cores,
+    # benchmarks/results/issue15_render_jobs.txt) of 120 frames or more (a worker takes about
+    # a second to start); one process for a GIF or a video, which the parent encodes.
+    jobs = ns.jobs if ns.jobs is not None else (os.cpu_count() or 1) if encode and len(times) >= 120 else 1
     if jobs > 1 and len(times) > 1:
-        return parallel.frames_2d_jobs(ns.scene, doc, times, size, background, jobs)
+        return parallel.frames_2d_jobs(ns.scene, doc, times, size, background, jobs, encode=encode)
     return frames_2d(doc, times, size, background)
 
 

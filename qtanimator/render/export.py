@@ -25,6 +25,7 @@ import math
 import os
 import tempfile
 from collections.abc import Callable, Iterable, Iterator
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -38,6 +39,28 @@ VIDEO_SUFFIXES = {".mp4": "libx264", ".mov": "libx264", ".mkv": "libx264", ".avi
 IMAGE_SUFFIXES = {".png", ".jpg", ".jpeg", ".bmp", ".tif", ".tiff"}
 
 Frame = npt.NDArray[np.uint8]
+
+
+@dataclass(frozen=True)
+class EncodedPng:
+    """A frame already encoded as PNG (by a render worker): written to a folder or pattern as
+    it is, decoded only for a GIF or a video. ``shape`` is the decoded array's shape."""
+
+    data: bytes
+    shape: tuple[int, int, int]
+
+    @classmethod
+    def of(cls, frame: npt.ArrayLike) -> EncodedPng:
+        import imageio.v3 as iio
+
+        a = np.asarray(frame)
+        return cls(bytes(iio.imwrite("<bytes>", a, extension=".png")), (a.shape[0], a.shape[1], a.shape[2]))
+
+    def decoded(self) -> Frame:
+        import imageio.v3 as iio
+
+        result: Frame = np.asarray(iio.imread(self.data, extension=".png"), dtype=np.uint8)
+        return result
 
 #: A GIF frame delay is a whole number of centiseconds; browsers play 0 or 1 cs as 10 cs.
 GIF_MIN_DELAY_CS = 2
@@ -152,8 +175,8 @@ def _check_frame(frame: npt.ArrayLike, shape: tuple[int, ...] | None) -> Frame:
     return a
 
 
-def _checked_frames(frames: Iterable[npt.ArrayLike], progress: Callable[[int], None] | None,
-                    cancel: Callable[[], bool] | None) -> Iterator[Frame]:
+def _checked_frames(frames: Iterable[npt.ArrayLike | EncodedPng], progress: Callable[[int], None] | None,
+                    cancel: Callable[[], bool] | None, keep_encoded: bool = False) -> Iterator[Any]:
     """``frames`` checked for type and a common size, stopping when ``cancel()`` says so;
     ``progress(n)`` is called once the consumer has written frame ``n``."""
     shape = None
@@ -161,9 +184,15 @@ def _checked_frames(frames: Iterable[npt.ArrayLike], progress: Callable[[int], N
     for frame in frames:
         if cancel is not None and cancel():
             return
-        a = _check_frame(frame, shape)
-        shape = a.shape
-        yield a
+        if isinstance(frame, EncodedPng):
+            if shape is not None and frame.shape[:2] != shape[:2]:
+                raise ValueError("all frames must have the same size")
+            shape = frame.shape
+            yield frame if keep_encoded else frame.decoded()
+        else:
+            a = _check_frame(frame, shape)
+            shape = a.shape
+            yield a
         done += 1
         if progress is not None:
             progress(done)
@@ -186,7 +215,7 @@ def _even(frame: Frame) -> Frame:
     return np.pad(frame, ((0, h % 2), (0, w % 2), (0, 0)), mode="edge")
 
 
-def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], fps: float,
+def write_frames(frames: Iterable[npt.ArrayLike | EncodedPng], out: str | os.PathLike[str], fps: float,
                  progress: Callable[[int], None] | None = None,
                  cancel: Callable[[], bool] | None = None, start: int = 0) -> int:
     """Write ``frames`` to ``out`` at ``fps``; returns the number of frames written.
@@ -210,8 +239,13 @@ def write_frames(frames: Iterable[npt.ArrayLike], out: str | os.PathLike[str], f
             parent = os.path.dirname(path)
             if parent:
                 os.makedirs(parent, exist_ok=True)
-        for a in _checked_frames(frames, progress, cancel):
-            iio.imwrite(pattern % (start + count), a)
+        for a in _checked_frames(frames, progress, cancel, keep_encoded=True):
+            name = pattern % (start + count)
+            if isinstance(a, EncodedPng):
+                with open(name, "wb") as f:  # encoded by a render worker: the bytes as they are
+                    f.write(a.data)
+            else:
+                iio.imwrite(name, a)
             count += 1
         return count
     parent = os.path.dirname(os.path.abspath(path))

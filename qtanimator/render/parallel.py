@@ -35,6 +35,9 @@ class ChunkSpec:
     size: tuple[int, int]
     background: str
     times: tuple[float, ...]
+    #: the worker encodes its frames as PNG (the output is a folder or pattern of PNGs), so the
+    #: parent only writes bytes
+    encode: bool = False
 
 
 def bake_2d(doc: Any, times: Sequence[float]) -> tuple[dict[str, Any], tuple[float, float, float, float]]:
@@ -48,14 +51,14 @@ def bake_2d(doc: Any, times: Sequence[float]) -> tuple[dict[str, Any], tuple[flo
 
 
 def chunk_specs(scene: str, doc: Any, times: Sequence[float], size: tuple[int, int], background: str,
-                chunks: int) -> list[ChunkSpec]:
+                chunks: int, encode: bool = False) -> list[ChunkSpec]:
     """``times`` cut into ``chunks`` contiguous, nearly equal pieces, baked once."""
     states, view = bake_2d(doc, times)
     n = len(times)
     chunks = max(1, min(chunks, n))
     bounds = [round(i * n / chunks) for i in range(chunks + 1)]
     return [ChunkSpec(os.path.abspath(scene), float(doc.fps), states, view, (size[0], size[1]), background,
-                      tuple(times[a:b])) for a, b in zip(bounds, bounds[1:], strict=False) if b > a]
+                      tuple(times[a:b]), encode) for a, b in zip(bounds, bounds[1:], strict=False) if b > a]
 
 
 _LOCAL = threading.local()  # a Dask worker may run chunks on several threads
@@ -74,8 +77,8 @@ def _worker_document(spec: ChunkSpec) -> Any:
     return doc
 
 
-def render_chunk(spec: ChunkSpec) -> list[np.ndarray]:
-    """RGBA frames of one chunk (runs in a worker process)."""
+def render_chunk(spec: ChunkSpec) -> list[Any]:
+    """RGBA frames of one chunk, or PNG-encoded ones (``spec.encode``); runs in a worker."""
     from qtanimator.render.cli_render import _ensure_gui_app
 
     _ensure_gui_app()
@@ -87,7 +90,12 @@ def render_chunk(spec: ChunkSpec) -> list[np.ndarray]:
     doc = _worker_document(spec)
     simulation(doc).load_baked_states(spec.states)
     view = QRectF(*spec.view)
-    return [image_to_array(render_frame(doc, t, spec.size, spec.background, view=view)) for t in spec.times]
+    frames = [image_to_array(render_frame(doc, t, spec.size, spec.background, view=view)) for t in spec.times]
+    if spec.encode:
+        from qtanimator.render.export import EncodedPng
+
+        return [EncodedPng.of(a) for a in frames]
+    return frames
 
 
 def _ordered(submit: Callable[[ChunkSpec], Any], result: Callable[[Any], list[np.ndarray]],
@@ -108,11 +116,11 @@ def _ordered(submit: Callable[[ChunkSpec], Any], result: Callable[[Any], list[np
 
 
 def frames_2d_jobs(scene: str, doc: Any, times: Sequence[float], size: tuple[int, int], background: str,
-                   jobs: int, chunk_frames: int = 24) -> Iterator[np.ndarray]:
+                   jobs: int, chunk_frames: int = 24, encode: bool = False) -> Iterator[Any]:
     """The frames of :func:`qtanimator.render.cli_render.frames_2d`, rendered in ``jobs``
     spawned processes."""
     n_chunks = max(jobs, -(-len(times) // chunk_frames))
-    specs = chunk_specs(scene, doc, times, size, background, n_chunks)
+    specs = chunk_specs(scene, doc, times, size, background, n_chunks, encode)
     jobs = max(1, min(jobs, len(specs)))
     pool = ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("spawn"))
     try:
@@ -125,7 +133,7 @@ def frames_2d_jobs(scene: str, doc: Any, times: Sequence[float], size: tuple[int
 
 
 def frames_2d_dask(scene: str, doc: Any, times: Sequence[float], size: tuple[int, int], background: str,
-                   address: str | Any, chunk_frames: int = 24) -> Iterator[np.ndarray]:
+                   address: str | Any, chunk_frames: int = 24, encode: bool = False) -> Iterator[Any]:
     """The same chunks sent to a Dask distributed scheduler at ``address`` (or an existing
     ``distributed.Client``)."""
     try:
@@ -137,7 +145,7 @@ def frames_2d_dask(scene: str, doc: Any, times: Sequence[float], size: tuple[int
     try:
         workers = max(1, sum(client.nthreads().values()))
         n_chunks = max(workers, -(-len(times) // chunk_frames))
-        specs = chunk_specs(scene, doc, times, size, background, n_chunks)
+        specs = chunk_specs(scene, doc, times, size, background, n_chunks, encode)
 
         def submit(spec: ChunkSpec) -> Any:
             return client.submit(render_chunk, spec, pure=False)

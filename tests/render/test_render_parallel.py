@@ -5,6 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from needs import missing
 
 from qtanimator.render.cli_render import render_main
 
@@ -22,6 +23,17 @@ def test_jobs_2_frames_equal_single_process(qapp, tmp_path: Path, scene: str) ->
     one = _render(SCENES / scene, tmp_path / "one", "--jobs", "1")
     two = _render(SCENES / scene, tmp_path / "two", "--jobs", "2")
     assert len(one) == 30 and one == two
+
+
+def test_jobs_2_gif_equals_single_process(qapp, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    """A GIF is encoded from raw frames in the parent (the workers encode only PNG frames)."""
+    outs = []
+    for jobs in ("1", "2"):
+        out = tmp_path / f"clock{jobs}.gif"
+        assert render_main([str(SCENES / "pendulum_clock.svg"), "-o", str(out), "--frames", "0:29", "--size",
+                            "120x90", "--quiet", "--jobs", jobs]) == 0
+        outs.append(out.read_bytes())
+    assert outs[0] == outs[1]
 
 
 def test_pendulums_are_baked_in_the_parent(qapp, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
@@ -50,7 +62,10 @@ def test_jobs_must_be_positive(qapp, tmp_path: Path, capsys) -> None:  # type: i
 
 
 def test_dask_local_cluster_frames_equal_single_process(qapp, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
-    distributed = pytest.importorskip("distributed", reason="the optional 'dask' extra is not installed")
+    try:
+        import distributed
+    except ImportError:  # a test dependency (pyproject's test extra): in CI this fails
+        missing("the 'distributed' package is not installed")
     one = _render(SCENES / "pendulum_clock.svg", tmp_path / "one", "--jobs", "1")
     with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
                                   dashboard_address=None) as cluster:
