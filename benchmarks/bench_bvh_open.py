@@ -10,32 +10,14 @@ from __future__ import annotations
 import argparse
 import os
 import statistics
-import time
-from collections.abc import Callable
 from datetime import date
 from pathlib import Path
 
+from benchmarks.common import interleaved_times, median_range_ms
 from qtanimator.document.character3d import load_bvh_character
 from qtanimator.formats.bvh import load_bvh
 
 DATA = Path(__file__).resolve().parents[2] / "shared" / "data" / "bvh"
-
-
-def _times(fns: dict[str, Callable[[], object]], repeats: int) -> dict[str, list[float]]:
-    for fn in fns.values():
-        fn()
-    out: dict[str, list[float]] = {name: [] for name in fns}
-    for _ in range(repeats):
-        for name, fn in fns.items():  # taking turns: a burst of load hits both alike
-            start = time.perf_counter()
-            fn()
-            out[name].append(time.perf_counter() - start)
-    return out
-
-
-def _fmt(ts: list[float]) -> str:
-    ms = [t * 1e3 for t in ts]
-    return f"{statistics.median(ms):.2f} [{min(ms):.2f}-{max(ms):.2f}] ms"
 
 
 def run(repeats: int) -> list[str]:
@@ -48,12 +30,12 @@ def run(repeats: int) -> list[str]:
              "bvhio.readAsHierarchy | ratio bvhio/ours"]
     for path in sorted(DATA.glob("*.bvh")):
         p = str(path)
-        times = _times({"ours": lambda p=p: load_bvh_character(p),  # type: ignore[misc]
+        times = interleaved_times({"ours": lambda p=p: load_bvh_character(p),  # type: ignore[misc]
                         "bvhio": lambda p=p: bvhio.readAsHierarchy(p)}, repeats)  # type: ignore[misc]
         clip = load_bvh(p)
         ratio = statistics.median(times["bvhio"]) / statistics.median(times["ours"])
         lines.append(f"{path.name} | {path.stat().st_size:,} B | {clip.frame_count} x {clip.channel_count} | "
-                     f"{_fmt(times['ours'])} | {_fmt(times['bvhio'])} | {ratio:.2f}")
+                     f"{median_range_ms(times['ours'])} | {median_range_ms(times['bvhio'])} | {ratio:.2f}")
     lines.append(f"# load average after {os.getloadavg()[0]:.2f}")
     return lines
 

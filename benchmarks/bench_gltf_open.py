@@ -15,11 +15,10 @@ import os
 import statistics
 import sys
 import tempfile
-import time
-from collections.abc import Callable
 from datetime import date
 from pathlib import Path
 
+from benchmarks.common import interleaved_times, median_range_ms
 from qtanimator.document import Document, UndoStack
 from qtanimator.document.character3d import skinned_mesh
 from qtanimator.document.import3d import import_file
@@ -33,23 +32,6 @@ def _open(path: str) -> tuple[Document, str]:
     imp = import_file(doc, path)
     UndoStack(doc).push(imp.command)
     return doc, imp.asset_id
-
-
-def _times(fns: dict[str, Callable[[], object]], repeats: int) -> dict[str, list[float]]:
-    for fn in fns.values():
-        fn()
-    out: dict[str, list[float]] = {name: [] for name in fns}
-    for _ in range(repeats):
-        for name, fn in fns.items():  # taking turns: a burst of load hits both alike
-            start = time.perf_counter()
-            fn()
-            out[name].append(time.perf_counter() - start)
-    return out
-
-
-def _fmt(ts: list[float]) -> str:
-    ms = [t * 1e3 for t in ts]
-    return f"{statistics.median(ms):.2f} [{min(ms):.2f}-{max(ms):.2f}] ms"
 
 
 def run(repeats: int) -> list[str]:
@@ -67,17 +49,18 @@ def run(repeats: int) -> list[str]:
              "pygltflib.GLTF2.load | ratio ours/pygltflib | pose + skin one frame"]
     for path in files:
         p = str(path)
-        times = _times({"ours": lambda p=p: _open(p),  # type: ignore[misc]
+        times = interleaved_times({"ours": lambda p=p: _open(p),  # type: ignore[misc]
                         "pygltflib": lambda p=p: pygltflib.GLTF2.load(p)}, repeats)  # type: ignore[misc]
         doc, aid = _open(p)
         ch = doc.runtime[aid]
         keys = sum(len(c.keys) for c in doc.channels.values())
         mid = 0.5 * (ch.clips[0].start + ch.clips[0].end) if ch.clips else 0.0
-        frame = _times({"pose": lambda d=doc, a=aid, t=mid: skinned_mesh(d, a, t)}, repeats)["pose"]  # type: ignore[misc]
+        frame = interleaved_times({"pose": lambda d=doc, a=aid, t=mid: skinned_mesh(d, a, t)}, repeats)["pose"]  # type: ignore[misc]
         ratio = statistics.median(times["ours"]) / statistics.median(times["pygltflib"])
         lines.append(f"{path.name} | {path.stat().st_size:,} B | {len(ch.parts)} / {len(ch.skeleton.joints)} / "
-                     f"{len(ch.clips)} ({keys:,}) | {_fmt(times['ours'])} | {_fmt(times['pygltflib'])} | "
-                     f"{ratio:.2f} | {_fmt(frame)}")
+                     f"{len(ch.clips)} ({keys:,}) | {median_range_ms(times['ours'])} | "
+                     f"{median_range_ms(times['pygltflib'])} | "
+                     f"{ratio:.2f} | {median_range_ms(frame)}")
     lines.append(f"# load average after {os.getloadavg()[0]:.2f}")
     return lines
 

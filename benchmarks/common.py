@@ -5,6 +5,7 @@ A row is a plain dict; see ``benchmarks/__main__.py`` for the keys the runner pr
 
 from __future__ import annotations
 
+import statistics
 import time
 from collections.abc import Callable
 from typing import Any
@@ -65,3 +66,23 @@ def print_rows(rows: list[dict[str, Any]], columns: list[str]) -> int:
         extras = {k: v for k, v in r.items() if k not in columns and k != "peer"}
         print(" | ".join(str(r.get(c, "")) for c in columns) + (f"  {extras}" if extras else ""))
     return 0
+
+
+def interleaved_times(fns: dict[str, Callable[[], object]], repeats: int) -> dict[str, list[float]]:
+    """Every run's seconds of each function, after one warm-up call each; the functions take
+    turns, so a burst of load hits them alike."""
+    for fn in fns.values():
+        fn()
+    out: dict[str, list[float]] = {name: [] for name in fns}
+    for _ in range(repeats):
+        for name, fn in fns.items():
+            start = time.perf_counter()
+            fn()
+            out[name].append(time.perf_counter() - start)
+    return out
+
+
+def median_range_ms(ts: list[float]) -> str:
+    """``median [min-max] ms`` of run times given in seconds."""
+    ms = [t * 1e3 for t in ts]
+    return f"{statistics.median(ms):.2f} [{min(ms):.2f}-{max(ms):.2f}] ms"

@@ -26,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 import numpy.typing as npt
 
-from qtanimator.core.channel import Channel, Interpolation, Key
+from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key
 from qtanimator.core.rotation import euler_filter, euler_to_quaternions, normalize, quaternions_to_euler, slerp
 
 FloatArray = npt.NDArray[np.float64]
@@ -84,16 +84,22 @@ def quaternion_at(channels: Sequence[Channel | None], rest: npt.ArrayLike, time:
     plan = _plan(channels)
     t = float(time)
     if plan is not None:
-        times, keys, linear = plan
+        times, keys, linear, hold_before, hold_after = plan
         if times[0] < t < times[-1]:
             i = bisect_right(times, t) - 1
             if linear[i]:
                 u = (t - times[i]) / (times[i + 1] - times[i])
                 return np.array(_slerp_floats(keys[i], keys[i + 1], u))
+        # at or outside the end keys with constant extrapolation: the end key itself (what
+        # evaluating each component there and normalising gives, without compiling them)
+        elif t <= times[0] and hold_before:
+            return np.array(keys[0])
+        elif t >= times[-1] and hold_after:
+            return np.array(keys[-1])
     return quaternions_at(channels, rest, [t])[0]
 
 
-_Plan = tuple[list[float], list[tuple[float, float, float, float]], list[bool]]
+_Plan = tuple[list[float], list[tuple[float, float, float, float]], list[bool], bool, bool]
 
 
 def _plan(channels: Sequence[Channel | None]) -> _Plan | None:
@@ -113,13 +119,12 @@ def _plan(channels: Sequence[Channel | None]) -> _Plan | None:
         times = [k.time for k in first.keys]
         if all([k.time for k in c.keys] == times for c in channels[1:] if c is not None):
             w, x, y, z = ([k.value for k in c.keys] for c in channels if c is not None)
-            keys = []
-            for q in zip(x, y, z, w):
-                n = math.sqrt(sum(v * v for v in q)) or 1.0
-                keys.append((q[0] / n, q[1] / n, q[2] / n, q[3] / n))
+            keys = [tuple(q) for q in normalize(np.array([x, y, z, w]).T).tolist()]
             linear = [all(c.keys[i].interpolation is Interpolation.LINEAR for c in channels if c is not None)
                       for i in range(len(times) - 1)]
-            plan = (times, keys, linear)
+            chans = [c for c in channels if c is not None]
+            plan = (times, keys, linear, all(c.pre is Extrapolation.CONSTANT for c in chans),
+                    all(c.post is Extrapolation.CONSTANT for c in chans))
     # the other channels are kept alive with the plan, so their ids stay theirs
     first._derived["quaternion_plan"] = (ids, plan, tuple(channels))
     return plan

@@ -309,3 +309,26 @@ class Character:
             c = self.rest_pivots[0] if pose is None else pose.pivots[0]
             return float(c[0]), float(c[1]), float(c[0]), float(c[1])
         return min(xs), min(ys), max(xs), max(ys)
+
+
+def angle_sums(ch: Character) -> tuple[FloatArray, FloatArray]:
+    """How a joint's world angle is built from local angles: ``(key_sum, dyn_pick)``, both
+    (J, J). ``key_sum[k]`` sums the keyed local angles of ``k`` and its keyed ancestors up to
+    (not including) the nearest dynamic one, whose world angle ``dyn_pick[k]`` picks (a row
+    of zeros when there is none): ``world = key_sum @ local + dyn_pick @ dynamic_world``."""
+    n = len(ch.joints)
+    key_sum = np.zeros((n, n))
+    dyn_pick = np.zeros((n, n))
+    nearest = [-1] * n
+    for k, j in enumerate(ch.joints):
+        p = j.parent
+        if j.is_dynamic:
+            nearest[k] = k
+        else:
+            if p is not None:
+                key_sum[k] = key_sum[p]
+                nearest[k] = nearest[p]
+            key_sum[k, k] = 1.0
+        if nearest[k] >= 0:
+            dyn_pick[k, nearest[k]] = 1.0
+    return key_sum, dyn_pick

@@ -35,7 +35,7 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.joint_bounce import Bounce, BoundedUnit, bounded_step
-from qtanimator.core.rig2d import Character
+from qtanimator.core.rig2d import Character, angle_sums
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -140,21 +140,7 @@ class SpringSystem:
         ch = character
         n = len(ch.joints)
         self.joints = np.flatnonzero(np.array([j.is_spring and not j.is_dynamic for j in ch.joints], dtype=bool))
-        key_sum = np.zeros((n, n))
-        dyn_pick = np.zeros((n, n))
-        nearest = [-1] * n
-        for k, j in enumerate(ch.joints):
-            p = j.parent
-            if j.is_dynamic:
-                nearest[k] = k
-            else:
-                if p is not None:
-                    key_sum[k] = key_sum[p]
-                    nearest[k] = nearest[p]
-                key_sum[k, k] = 1.0
-            if nearest[k] >= 0:
-                dyn_pick[k, nearest[k]] = 1.0
-        self.key_sum, self.dyn_pick = key_sum, dyn_pick
+        self.key_sum, self.dyn_pick = angle_sums(ch)
         self.limits = np.tile(np.array([-math.inf, math.inf]), (n, 1))
         for k, lim in enumerate(limits or []):
             if lim is not None and k < n:

@@ -44,7 +44,7 @@ import threading
 import time
 import weakref
 from collections import Counter
-from collections.abc import Callable, Hashable, Iterable
+from collections.abc import Callable, Hashable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -53,7 +53,7 @@ import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Key
 from qtanimator.core.pendulum import PRESETS, PendulumBlowUp, PendulumParams, PendulumSystem, check_state
-from qtanimator.core.rig2d import Character, Pose
+from qtanimator.core.rig2d import Character, Pose, angle_sums
 from qtanimator.core.spring_joint import SPRING_PRESETS, SpringParams, SpringSystem
 from qtanimator.document.commands import AddAsset, Command, DeleteKeys, Macro, SetKeys, SetParameter
 from qtanimator.document.document import (
@@ -547,49 +547,50 @@ def delete_keys_at(doc: Document, asset_id: str | None, time: float) -> Command 
 
 
 # -------------------------------------------------------------- pendulum params
-def pendulum_params(doc: Document, asset_id: str) -> PendulumParams:
-    prefix = f"{asset_id}.pendulum."
+def _preset_params(doc: Document, prefix: str, presets: Mapping[str, Any], default: str) -> Any:
+    """A named preset (``default`` when unset) with the parameters ``prefix + <name>`` over
+    it; the preset itself when they do not make valid constants."""
     # list() copies in one step: the simulation worker may read while the UI thread edits.
     values = {k[len(prefix):]: v for k, v in list(doc.parameters.items()) if k.startswith(prefix)}
-    preset = PRESETS.get(str(values.pop("preset", "physical")), PRESETS["physical"])
+    preset = presets.get(str(values.pop("preset", default)), presets[default])
     try:
-        return PendulumParams.from_dict({**preset.to_dict(), **values})
+        return type(preset).from_dict({**preset.to_dict(), **values})
     except (TypeError, ValueError):
         return preset
 
 
+def _preset_command(doc: Document, prefix: str, presets: Mapping[str, Any], name: str, what: str) -> Command:
+    """Every parameter ``prefix + <name>`` set to the preset ``name`` (one undo step)."""
+    if name not in presets:
+        raise ValueError(f"unknown {what.lower()} preset '{name}' (known: {', '.join(presets)})")
+    cmds: list[Command] = [SetParameter(doc, prefix + "preset", name)]
+    for k, v in presets[name].to_dict().items():
+        cmds.append(SetParameter(doc, prefix + k, v))
+    return Macro(f"{what} preset: {name}", cmds)
+
+
+def pendulum_params(doc: Document, asset_id: str) -> PendulumParams:
+    """The pendulum constants of a character: its preset (``physical`` when unset) with the
+    parameters ``"<asset>.pendulum.<name>"`` over it."""
+    params: PendulumParams = _preset_params(doc, f"{asset_id}.pendulum.", PRESETS, "physical")
+    return params
+
+
 def set_pendulum_preset(doc: Document, asset_id: str, name: str) -> Command:
     """Set all of a character's pendulum parameters to a named preset (one undo step)."""
-    if name not in PRESETS:
-        raise ValueError(f"unknown pendulum preset '{name}' (known: {', '.join(PRESETS)})")
-    prefix = f"{asset_id}.pendulum."
-    cmds: list[Command] = [SetParameter(doc, prefix + "preset", name)]
-    for k, v in PRESETS[name].to_dict().items():
-        cmds.append(SetParameter(doc, prefix + k, v))
-    return Macro(f"Pendulum preset: {name}", cmds)
+    return _preset_command(doc, f"{asset_id}.pendulum.", PRESETS, name, "Pendulum")
 
 
 def spring_params(doc: Document, asset_id: str) -> SpringParams:
     """The spring joints' constants of a character: its preset (``soft`` when unset) with
     the parameters ``"<asset>.spring.<name>"`` over it."""
-    prefix = f"{asset_id}.spring."
-    values = {k[len(prefix):]: v for k, v in list(doc.parameters.items()) if k.startswith(prefix)}
-    preset = SPRING_PRESETS.get(str(values.pop("preset", "soft")), SPRING_PRESETS["soft"])
-    try:
-        return SpringParams.from_dict({**preset.to_dict(), **values})
-    except (TypeError, ValueError):
-        return preset
+    params: SpringParams = _preset_params(doc, f"{asset_id}.spring.", SPRING_PRESETS, "soft")
+    return params
 
 
 def set_spring_preset(doc: Document, asset_id: str, name: str) -> Command:
     """Set all of a character's spring constants to a named preset (one undo step)."""
-    if name not in SPRING_PRESETS:
-        raise ValueError(f"unknown spring preset '{name}' (known: {', '.join(SPRING_PRESETS)})")
-    prefix = f"{asset_id}.spring."
-    cmds: list[Command] = [SetParameter(doc, prefix + "preset", name)]
-    for k, v in SPRING_PRESETS[name].to_dict().items():
-        cmds.append(SetParameter(doc, prefix + k, v))
-    return Macro(f"Spring preset: {name}", cmds)
+    return _preset_command(doc, f"{asset_id}.spring.", SPRING_PRESETS, name, "Spring")
 
 
 def _keyed_angles_at(channels: dict[str, Channel], asset_id: str, ch: Character, times: FloatArray,
@@ -643,23 +644,7 @@ class _AssetSim:
         self.generation = 0
         #: Why the simulation stopped after its last cached frame (a blow-up), or None.
         self.problem: PendulumBlowUp | None = None
-        n = len(ch.joints)
-        key_sum = np.zeros((n, n))
-        dyn_pick = np.zeros((n, n))
-        nearest = [-1] * n
-        for k, j in enumerate(ch.joints):
-            p = j.parent
-            if j.is_dynamic:
-                nearest[k] = k
-            else:
-                if p is not None:
-                    key_sum[k] = key_sum[p]
-                    nearest[k] = nearest[p]
-                key_sum[k, k] = 1.0
-            if nearest[k] >= 0:
-                dyn_pick[k, nearest[k]] = 1.0
-        self.key_sum = key_sum
-        self.dyn_pick = dyn_pick
+        self.key_sum, self.dyn_pick = angle_sums(ch)
         self.tops = np.array([g.top for g in self.system.groups], dtype=np.intp)
         top_of, anc, vec = [], [], []
         for ti, t in enumerate(self.tops):

@@ -342,7 +342,9 @@ def _key_rate(channels: Iterable[Channel | None]) -> float | None:
     """The frame rate of keys evenly spaced in time (a BVH's frames, a glTF clip sampled at a
     fixed rate), whole when within 0.2 % of a whole number; None when the keys are not evenly
     spaced, fewer than two, or under 10 per second (key poses rather than frames)."""
-    times = [c.times for c in channels if c is not None and len(c.keys) >= 2]
+    # straight from the keys: compiling every channel of a long clip here costs more than reading it
+    times = [np.fromiter((k.time for k in c.keys), float, len(c.keys))
+             for c in channels if c is not None and len(c.keys) >= 2]
     if not times:
         return None
     t = np.unique(np.round(np.concatenate(times), 6))

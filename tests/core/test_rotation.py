@@ -200,3 +200,19 @@ def test_key_series_builds_the_same_keys_as_one_by_one_and_checks_them():
         Key.series([0.0, 1.0], [0.0, float("nan")], Interpolation.LINEAR)
     with pytest.raises(ValueError, match="slopes"):
         Key.series([0.0, 1.0], [0.0, 1.0], Interpolation.CUBIC, [0.0, float("inf")], [0.0, 0.0])
+
+
+def test_the_one_time_path_at_and_outside_the_end_keys_equals_the_array_path():
+    from qtanimator.core.channel import Extrapolation
+    from qtanimator.core.quaternion_channels import quaternion_at
+
+    rng = np.random.default_rng(4)
+    q = rng.normal(size=(3, 4)) * 2.0  # not unit: both paths normalise
+    chans = _quat_channels([0.5, 1.0, 2.0], list(q))
+    for t in (-1.0, 0.5, 2.0, 3.0):
+        assert np.allclose(quaternion_at(chans, [0, 0, 0, 1], t), quaternions_at(chans, [0, 0, 0, 1], [t])[0],
+                           atol=1e-15)
+    cycling = [c.with_extrapolation(Extrapolation.CYCLE, Extrapolation.CYCLE) for c in chans]
+    for t in (-0.2, 2.3):  # not held: the array path decides
+        assert np.allclose(quaternion_at(cycling, [0, 0, 0, 1], t), quaternions_at(cycling, [0, 0, 0, 1], [t])[0],
+                           atol=1e-15)
