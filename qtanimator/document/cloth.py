@@ -25,7 +25,7 @@ from __future__ import annotations
 import copy
 import math
 import threading
-from collections.abc import Callable, Hashable
+from collections.abc import Callable, Hashable, Mapping
 from typing import Any
 
 import numpy as np
@@ -60,6 +60,8 @@ class ClothCache:
         self.frames: list[FloatArray] = [self._freeze(self.cloth.positions)]
         self.error: ClothBlowUp | None = None
         self._lock = threading.Lock()
+        #: frames simulated in another process, by cache slot (see :meth:`load_baked`)
+        self._baked: dict[int, FloatArray] = {}
 
     @staticmethod
     def _freeze(a: FloatArray) -> FloatArray:
@@ -112,9 +114,18 @@ class ClothCache:
                 return False
         return True
 
+    def load_baked(self, frames: Mapping[int, FloatArray]) -> None:
+        """Use frames simulated elsewhere, by cache slot: ``render --jobs`` simulates the cloth
+        once in the parent and hands each worker the frames its chunk shows, which
+        :meth:`positions` then returns without simulating."""
+        self._baked = {int(k): self._freeze(v) for k, v in frames.items()}
+
     def positions(self, frame: float) -> FloatArray:
         """Positions at ``frame`` (read-only array), simulating forward as needed."""
         k = self.index_of(frame)
+        baked = self._baked.get(k)
+        if baked is not None:
+            return baked
         self.fill(k + 1)
         return self.frames[min(k, len(self.frames) - 1)]
 

@@ -48,10 +48,10 @@ def _parser() -> argparse.ArgumentParser:
                         "characters, else 3d)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--jobs", type=int,
-                   help="2D: render in N processes (default: all cores for 120 PNG frames or more, else 1); "
-                        "the pendulums are simulated once, here")
+                   help="render in N processes (default: all cores for 120 PNG frames or more, else 1); "
+                        "pendulums and cloth are simulated once, here")
     p.add_argument("--dask", metavar="ADDRESS",
-                   help="2D: render on a Dask distributed cluster (scheduler address such as "
+                   help="render on a Dask distributed cluster (scheduler address such as "
                         "tcp://host:8786; needs the 'dask' extra)")
     return p
 
@@ -119,23 +119,32 @@ def _ensure_gui_app() -> Any:
 
 
 class _Progress:
-    """A one-line progress bar redrawn with ``\\r``; quiet when stderr is not a terminal
-    (a log file or a pipe gets no bar, only the final summary)."""
+    """The render's progress bar: a tqdm bar on stderr when stderr is a terminal; nothing
+    when it is not (a log file or a pipe gets no ``\\r`` lines, only the final summary)."""
 
     def __init__(self, total: int, enabled: bool) -> None:
         self.total = max(total, 1)
         isatty = getattr(sys.stderr, "isatty", None)
         self.enabled = enabled and bool(isatty and isatty())
+        self._bar: Any = None
+        if self.enabled:
+            from tqdm import tqdm
+
+            self._bar = tqdm(total=self.total, file=sys.stderr, unit="frame", desc="rendering",
+                             dynamic_ncols=True, leave=True)
 
     def __call__(self, done: int) -> None:
-        if not self.enabled:
+        if self._bar is None:
             return
-        width = 30
-        filled = int(width * done / self.total)
-        sys.stderr.write(f"\rrendering [{'#' * filled}{'.' * (width - filled)}] {done}/{self.total}")
+        self._bar.update(done - self._bar.n)
         if done >= self.total:
-            sys.stderr.write("\n")
-        sys.stderr.flush()
+            self.close()
+
+    def close(self) -> None:
+        """End the bar's line (also when the render stops early)."""
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
 
 
 def frames_2d(doc: Any, times: Sequence[float], size: tuple[int, int], background: str) -> Iterator[np.ndarray]:
@@ -162,27 +171,30 @@ def options_3d(background: str | None) -> Any:
     return options
 
 
-def _frames_2d_any(ns: argparse.Namespace, doc: Any, times: Sequence[float], size: tuple[int, int],
-                   background: str) -> Iterator[np.ndarray]:
-    """:func:`frames_2d` in this process, in ``--jobs`` processes or on a ``--dask`` cluster."""
+def _frames_any(ns: argparse.Namespace, doc: Any, times: Sequence[float], size: tuple[int, int]) -> Iterator[Any]:
+    """The frames of ``ns.view`` in this process, in ``--jobs`` processes or on a ``--dask``
+    cluster (the same frames, byte for byte)."""
     from qtanimator.render import parallel
+    from qtanimator.render.export import output_kind
 
     if ns.jobs is not None and ns.jobs < 1:
         raise ValueError("--jobs must be at least 1")
     # PNG frames are encoded by the workers (the parent only writes the bytes); a GIF or a
     # video needs the raw frames in the parent.
-    from qtanimator.render.export import output_kind
-
     encode = output_kind(ns.output) in ("folder", "pattern")
     if ns.dask:
-        return parallel.frames_2d_dask(ns.scene, doc, times, size, background, ns.dask, encode=encode)
+        return parallel.frames_dask(ns.view, ns.scene, doc, times, size, ns.background, ns.dask, encode=encode)
     # By default all cores for PNG frames (encoded by the workers: 1.5-1.7x on 2 cores,
     # benchmarks/results/issue15_render_jobs.txt) of 120 frames or more (a worker takes about
     # a second to start); one process for a GIF or a video, which the parent encodes.
     jobs = ns.jobs if ns.jobs is not None else (os.cpu_count() or 1) if encode and len(times) >= 120 else 1
     if jobs > 1 and len(times) > 1:
-        return parallel.frames_2d_jobs(ns.scene, doc, times, size, background, jobs, encode=encode)
-    return frames_2d(doc, times, size, background)
+        return parallel.frames_jobs(ns.view, ns.scene, doc, times, size, ns.background, jobs, encode=encode)
+    if ns.view == "3d":
+        from qtanimator.render.render3d import render_frames_3d
+
+        return render_frames_3d(doc, times, size, options=options_3d(ns.background))
+    return frames_2d(doc, times, size, "white" if ns.background is None else ns.background)
 
 
 _KINDS_2D = ("character2d",)
@@ -238,8 +250,7 @@ def render_main(argv: Sequence[str]) -> int:
         with interrupt_on_signals():
             return _render_main(argv)
     except RenderInterrupted as exc:
-        lead = "" if "--quiet" in argv else "\n"  # end the progress line
-        print(f"{lead}qtanimator render: stopped by {exc.name}; a GIF or video output was not written "
+        print(f"qtanimator render: stopped by {exc.name}; a GIF or video output was not written "
               "(an existing file is left as it was)", file=sys.stderr)
         return exc.exit_status
 
@@ -266,7 +277,6 @@ def _render_main(argv: Sequence[str]) -> int:
         if ns.view == "3d":
             try:
                 from qtanimator.render import render3d
-                from qtanimator.render.render3d import render_frames_3d
             except ImportError as exc:
                 print(f"qtanimator render: the 3D view is not available ({exc}).", file=sys.stderr)
                 return 2
@@ -278,14 +288,12 @@ def _render_main(argv: Sequence[str]) -> int:
 
         if ns.background is not None:
             background_color(ns.background)  # a bad colour fails before rendering
-        if ns.view == "3d" and (ns.dask or (ns.jobs or 1) > 1):
-            raise ValueError("--jobs and --dask render 2D views; the 3D view renders in one process")
-        if ns.view == "3d":
-            frames: Any = render_frames_3d(doc, times, size, options=options_3d(ns.background))
-        else:
-            frames = _frames_2d_any(ns, doc, times, size, "white" if ns.background is None else ns.background)
+        frames = _frames_any(ns, doc, times, size)
         progress = _Progress(len(times), not ns.quiet)
-        n = write_frames(frames, ns.output, fps, progress=progress, start=first)
+        try:
+            n = write_frames(frames, ns.output, fps, progress=progress, start=first)
+        finally:
+            progress.close()
     except (FormatError, ValueError) as exc:
         print(f"qtanimator render: {exc}", file=sys.stderr)
         return 1

@@ -178,7 +178,9 @@ def test_progress_has_no_carriage_returns_off_a_terminal(monkeypatch) -> None:  
     p = cli_render._Progress(3, True)
     for i in (1, 2, 3):
         p(i)
-    assert "\r" in tty.getvalue() and "3/3" in tty.getvalue()
+    out = tty.getvalue()
+    assert "\r" in out and "3/3" in out
+    assert "frame/s" in out and out.endswith("\n")  # tqdm's rate column; the bar's line is ended
 
 
 def test_render_gif_at_60_fps_says_so_and_keeps_the_duration(
