@@ -68,10 +68,7 @@ def _wasp_document() -> Any:
     joints = re.findall(r"balljoint\s+([^\s{]+)", (WASP / "wasp.skel").read_text())
     ids = [channel_id("wasp", "", d) for d in ("tx", "ty", "tz")]
     ids += [channel_id("wasp", j, d) for j in joints for d in ("rx", "ry", "rz")]
-    doc = Document()
-    for cid, ch in zip(ids, clip.channels):
-        doc.channels[cid] = ch
-    return doc
+    return Document(channels=dict(zip(ids, clip.channels, strict=False)))
 
 
 def _bvh_document() -> Any:
@@ -96,7 +93,7 @@ def synthetic_document(channels: int = 300, keys: int = 2000, fps: float = 60.0)
     from qtanimator.document import Document, channel_id
 
     rng = np.random.default_rng(12)
-    doc = Document()
+    built: dict[str, Channel] = {}
     t = np.arange(keys) / fps
     for c in range(channels):
         amp = rng.uniform(2, 25) * np.array([1.0, rng.uniform(0, 0.35), rng.uniform(0, 0.12)])
@@ -109,9 +106,8 @@ def synthetic_document(channels: int = 300, keys: int = 2000, fps: float = 60.0)
                   for a, b in zip(t, v)]
         else:
             ks = [Key(float(a), float(b)) for a, b in zip(t, v)]
-        doc.channels[channel_id("synth", f"joint{c // 3:03d}", "r" + "xyz"[c % 3])] = Channel(ks)
-    doc.parameters["frame_end"] = keys
-    return doc
+        built[channel_id("synth", f"joint{c // 3:03d}", "r" + "xyz"[c % 3])] = Channel(ks)
+    return Document(channels=built, parameters={"frame_end": keys})
 
 
 def _stats(name: str, timed: tuple[list[float], list[float]], goal: float | None,

@@ -87,8 +87,7 @@ def add_robot(doc: Document) -> None:
 
 
 def build() -> Document:
-    doc = Document()
-    doc.parameters.update({"fps": FPS, "frame_start": 0, "frame_end": 240})
+    doc = Document(parameters={"fps": FPS, "frame_start": 0, "frame_end": 240})
     add_characters_command(doc, HERE / "demo" / "pip.svg").do(doc)
     add_characters_command(doc, HERE / "pendulum_clock.svg").do(doc)
 

@@ -5,6 +5,9 @@ the ``xcb`` platform on that private display, so QOpenGLWidget gets a real Mesa 
 context. When it cannot start, widgets run on the ``offscreen`` platform and the tests
 marked ``gl`` are skipped with the reason; in CI (``CI=true``) they fail instead, as do the
 tests that need ``../shared/data`` when it is missing (see ``tests/needs.py``).
+
+Hypothesis runs with the ``ci`` profile (fixed seeds) when ``CI=true`` and ``dev`` otherwise
+(``tests/hypothesis_profiles.py``).
 """
 
 from __future__ import annotations
@@ -13,6 +16,7 @@ import os
 import tempfile
 from pathlib import Path
 
+import hypothesis_profiles
 import pytest
 from needs import missing
 
@@ -52,6 +56,9 @@ def _configure_qt() -> None:
 
 
 _configure_qt()
+# Hypothesis: the "ci" profile (fixed seeds) with CI=true, "dev" otherwise; loaded here,
+# before any test module builds its settings (tests/hypothesis_profiles.py).
+hypothesis_profiles.load()
 
 
 def pytest_runtest_setup(item: pytest.Item) -> None:

@@ -157,6 +157,40 @@ def _decay(damping: float, tau: float) -> float:
     return math.inf if exponent > 709.0 else math.exp(exponent)
 
 
+Num = Any  # a float or a float array: the single-pendulum equation takes either
+
+
+def single_acceleration(c: Num, s: Num, ox: Num, oy: Num, ax: Num, ay: Num, mass: Num, g: float,
+                        inertia: Num, ell2: Num, point_mass_forcing: bool,
+                        live_inertia: Num = 1.0, live_ell2: Num = 1.0) -> Num:
+    """θ'' of uncoupled pendulum joints: the module's equation, written once, for floats
+    (one pendulum's fast loop) or arrays (every single joint at once) alike.
+
+    ``c``, ``s``: cos θ, sin θ of the world angle; (``ox``, ``oy``): the rest pivot → centre
+    of mass vector y0, so y = R(θ)·y0 = (c·ox + s·oy, −s·ox + c·oy) and y⊥ = J·y = (y.y, −y.x);
+    (``ax``, ``ay``): the pivot's acceleration a; ``inertia``: I about the pivot; ``ell2``:
+    |y0|² (the handout's point-mass forcing ``−⟨a, y⊥⟩ / L²`` in place of m / I). Then
+
+        I·θ'' = m·⟨(0, g), y⊥⟩ − m·⟨a, y⊥⟩,   ⟨(0, g), y⊥⟩ = −g·y.x = −g·L·sin(θ + φ).
+
+    A joint without inertia does not swing and one without a lever gets no point-mass
+    forcing: the caller passes 1 for such a divisor and 0 as its ``live_*`` factor.
+    """
+    yx = c * ox + s * oy
+    yy = -s * ox + c * oy
+    grav = mass * g * (-yx)
+    forcing = yy * ax - yx * ay
+    if point_mass_forcing:
+        return grav / inertia * live_inertia - forcing / ell2 * live_ell2
+    return (grav - mass * forcing) / inertia * live_inertia
+
+
+def _divisor(x: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``x`` as a divisor of :func:`single_acceleration` and its live factor (1 where x > 0)."""
+    live = x > 0
+    return np.where(live, x, 1.0), live.astype(np.float64)
+
+
 def rotate(v: FloatArray, theta: FloatArray | float) -> FloatArray:
     """R(θ)·v, vectorised over leading axes (θ broadcast against v[..., 0])."""
     c, s = np.cos(theta), np.sin(theta)
@@ -242,19 +276,8 @@ class PendulumSystem:
         p = self.params
         gvec = np.array([0.0, p.g])
         if not p.coupled or len(g.joints) == 1:
-            y = rotate(g.offset, theta)
-            yp = perp(y)
-            grav = g.mass * (yp @ gvec)  # = −m g L sin(θ + φ)
-            forcing = yp @ pivot_acc
-            if p.point_mass_forcing:
-                ell2 = (g.offset ** 2).sum(axis=1)
-                f = np.where(ell2 > 0, forcing / np.where(ell2 > 0, ell2, 1.0), 0.0)
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    out = np.where(g.inertia > 0, grav / g.inertia, 0.0) - f
-            else:
-                with np.errstate(divide="ignore", invalid="ignore"):
-                    out = np.where(g.inertia > 0, (grav - g.mass * forcing) / g.inertia, 0.0)
-            return np.asarray(out, dtype=np.float64)
+            return self._uncoupled(theta, pivot_acc[..., 0], pivot_acc[..., 1], g.mass, g.inertia, g.offset,
+                                   (g.offset ** 2).sum(axis=1))
         # Coupled: w_ik = R(θ_i) v_ik (zero unless i is k or an ancestor of k).
         n = len(g.joints)
         w = rotate(g.arm, theta[:, None]) * g.ancestor[:, :, None]
@@ -290,18 +313,15 @@ class PendulumSystem:
         idx, mass, inertia, offset, ell2 = self._singles
         if sel is not None:
             mass, inertia, offset, ell2 = mass[sel], inertia[sel], offset[sel], ell2[sel]
+        return self._uncoupled(th, acc[:, 0], acc[:, 1], mass, inertia, offset, ell2)
+
+    def _uncoupled(self, th: FloatArray, ax: FloatArray, ay: FloatArray, mass: FloatArray, inertia: FloatArray,
+                   offset: FloatArray, ell2: FloatArray) -> FloatArray:
         p = self.params
-        c, s = np.cos(th), np.sin(th)
-        yx = c * offset[:, 0] + s * offset[:, 1]
-        yy = -s * offset[:, 0] + c * offset[:, 1]
-        # y⊥ = J·y = (y.y, −y.x); gravity term m·<(0, g), y⊥> = −m g L sin(θ + φ)
-        grav = mass * p.g * (-yx)
-        forcing = yy * acc[:, 0] - yx * acc[:, 1]
-        with np.errstate(divide="ignore", invalid="ignore"):
-            if p.point_mass_forcing:
-                out = np.where(inertia > 0, grav / inertia, 0.0) - np.where(ell2 > 0, forcing / ell2, 0.0)
-            else:
-                out = np.where(inertia > 0, (grav - mass * forcing) / inertia, 0.0)
+        inertia, live_inertia = _divisor(inertia)
+        ell2, live_ell2 = _divisor(ell2)
+        out = single_acceleration(np.cos(th), np.sin(th), offset[:, 0], offset[:, 1], ax, ay, mass, p.g,
+                                  inertia, ell2, p.point_mass_forcing, live_inertia, live_ell2)
         return np.asarray(out, dtype=np.float64)
 
     def _advance_singles(self, th: FloatArray, om: FloatArray, acc: FloatArray,
@@ -523,16 +543,12 @@ class PendulumSystem:
         point = self.params.point_mass_forcing
         leap = self.params.integrator == "leapfrog"
 
+        live_i, live_l = (1.0 if inert > 0 else 0.0), (1.0 if l2 > 0 else 0.0)
+        inert, l2 = (inert if inert > 0 else 1.0), (l2 if l2 > 0 else 1.0)
+
         def f(t: float) -> float:
-            c, s = math.cos(t), math.sin(t)
-            yx = c * ox + s * oy
-            yy = -s * ox + c * oy
-            forcing = yy * ax - yx * ay
-            if inert <= 0:
-                return 0.0
-            if point:
-                return -m * g * yx / inert - (forcing / l2 if l2 > 0 else 0.0)
-            return (-m * g * yx - m * forcing) / inert
+            return float(single_acceleration(math.cos(t), math.sin(t), ox, oy, ax, ay, m, g, inert, l2, point,
+                                             live_i, live_l))
 
         th, om = float(theta[j]), float(omega[j])
         traj_t[:] = theta
@@ -651,7 +667,16 @@ def pivot_accelerations(character: Character, world_angles: FloatArray, world_ra
     c = character.rest_pivots
     for k in range(1, n):
         m = int(character.parents[k])
-        v = c[k] - c[m]
-        rv = rotate(v, world_angles[m])
-        acc[k] = acc[m] + rotation_accel_scale * (world_accels[m] * perp(rv) - world_rates[m] ** 2 * rv)
+        acc[k] = acc[m] + rotation_pivot_terms(world_angles[m:m + 1], world_rates[m:m + 1], world_accels[m:m + 1],
+                                               (c[k] - c[m])[None, :], rotation_accel_scale)[0]
     return acc
+
+
+def rotation_pivot_terms(angles: FloatArray, rates: FloatArray, accels: FloatArray, arms: FloatArray,
+                         scale: float = 1.0) -> FloatArray:
+    """The pivot acceleration an ancestor's rotation adds, for each (ancestor, rest arm v to
+    the pivot): scale·(Θ''·J·R(Θ)·v − Θ'²·R(Θ)·v), the last two terms of
+    p_n'' = p_m'' + Θ_m''·R(Θ_m)·J·v − Θ_m'²·R(Θ_m)·v (:func:`pivot_accelerations`; the
+    document's simulation sums them over each pendulum's ancestors)."""
+    rv = rotate(arms, angles)
+    return np.asarray(scale * (accels[:, None] * perp(rv) - (rates ** 2)[:, None] * rv), dtype=np.float64)

@@ -206,8 +206,10 @@ def quaternion_channels(channels: Sequence[Channel | None], rest: npt.ArrayLike,
     if len(times) == 0:
         return [None, None, None, None]
     r = np.asarray(rest, dtype=np.float64).reshape(3)
-    angles = np.stack([r[a] if c is None or not c.keys else c.evaluate(times)
-                       for a, c in enumerate(channels)], axis=-1).reshape(len(times), 3)
+    # an axis without keys holds its rest angle at every sampled time
+    angles = np.stack([np.full(len(times), r[a]) if c is None or not c.keys
+                       else np.asarray(c.evaluate(times), dtype=np.float64).reshape(len(times))
+                       for a, c in enumerate(channels)], axis=-1)
     q = euler_to_quaternions(angles, order)
     for k in range(1, len(q)):
         if float(np.dot(q[k], q[k - 1])) < 0.0:

@@ -24,10 +24,10 @@ ROTATION_ORDERS = ("xyz", "xzy", "yxz", "yzx", "zxy", "zyx")
 IDENTITY = np.array([0.0, 0.0, 0.0, 1.0])
 
 __all__ = [
-    "AXES", "IDENTITY", "ROTATION_ORDERS", "axis_rotations", "euler_filter", "euler_from_matrices",
-    "euler_to_quaternions", "matrices_to_quaternions", "normalize", "polar", "quaternion_conjugate",
-    "quaternion_multiply", "quaternion_to_matrix", "quaternions_to_euler", "rotation_matrices", "same_hemisphere",
-    "slerp", "trs_matrix",
+    "AXES", "IDENTITY", "ROTATION_ORDERS", "axis_quaternions", "axis_rotations", "euler_filter",
+    "euler_from_matrices", "euler_quaternions_with_rates", "euler_to_quaternions", "matrices_to_quaternions",
+    "normalize", "polar", "quaternion_conjugate", "quaternion_multiply", "quaternion_to_matrix",
+    "quaternions_to_euler", "rotation_matrices", "same_hemisphere", "slerp", "trs_matrix",
 ]
 
 
@@ -231,6 +231,41 @@ def euler_to_quaternions(angles: npt.ArrayLike, order: str) -> FloatArray:
 def quaternions_to_euler(q: npt.ArrayLike, order: str) -> FloatArray:
     """(N, 4) unit quaternions → (N, 3) Euler angles (see :func:`euler_from_matrices`)."""
     return euler_from_matrices(quaternion_to_matrix(np.asarray(q, dtype=np.float64).reshape(-1, 4)), order)
+
+
+def axis_quaternions(angles: FloatArray, axis: int) -> FloatArray:
+    """(…) angles (radians) → (…, 4) quaternions of the rotations about x (0), y (1) or z (2)."""
+    q = np.zeros(angles.shape + (4,))
+    q[..., axis] = np.sin(angles / 2)
+    q[..., 3] = np.cos(angles / 2)
+    return q
+
+
+def euler_quaternions_with_rates(angles: FloatArray, rates: FloatArray | None,
+                                 order: str) -> tuple[FloatArray, FloatArray | None]:
+    """Quaternions (and their time derivatives) of ``R_a(θa)·R_b(θb)·R_c(θc)`` for ``order``
+    ``"abc"``; ``angles`` and ``rates`` are (..., 3) in x, y, z order.
+
+    The product of the three axis quaternions, signs as they come (unlike
+    :func:`euler_to_quaternions`, which goes through the matrix and returns ``w ≥ 0``), so the
+    derivative ``dq`` (from ``rates``, by the product rule) is that of ``q`` itself.
+    """
+    axes = ["xyz".index(c) for c in order]
+    qs = [axis_quaternions(angles[..., a], a) for a in axes]
+    q = quaternion_multiply(quaternion_multiply(qs[0], qs[1]), qs[2])
+    if rates is None:
+        return q, None
+    dqs = []
+    for a in axes:
+        half = angles[..., a] / 2
+        d = np.zeros(angles.shape[:-1] + (4,))
+        d[..., a] = 0.5 * np.cos(half) * rates[..., a]
+        d[..., 3] = -0.5 * np.sin(half) * rates[..., a]
+        dqs.append(d)
+    dq = (quaternion_multiply(quaternion_multiply(dqs[0], qs[1]), qs[2])
+          + quaternion_multiply(quaternion_multiply(qs[0], dqs[1]), qs[2])
+          + quaternion_multiply(quaternion_multiply(qs[0], qs[1]), dqs[2]))
+    return q, dq
 
 
 # ------------------------------------------------------------------------ matrices

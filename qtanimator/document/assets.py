@@ -1,7 +1,8 @@
 """Loading the object behind an asset (a character, a skeleton...) by asset kind.
 
-Engines register a loader per kind; the document calls it when a project is opened.
-A loader raises FormatError for a source it cannot read.
+Engines register a loader per kind (the built-in ones in :mod:`qtanimator.document.loaders`,
+which imports this registry, never the other way round); the document calls it when a
+project is opened. A loader raises FormatError for a source it cannot read.
 """
 
 from __future__ import annotations
@@ -21,13 +22,8 @@ def register_loader(kind: str, loader: Loader) -> None:
 
 
 def load_runtime(asset: Asset) -> Any:
-    """The loaded object for ``asset``, or None for kinds that need no file."""
-    _ensure_builtin_loaders()
+    """The loaded object for ``asset`` by the loader registered for its kind, or None for
+    kinds without one (that need no file). The built-in kinds are registered by importing
+    :mod:`qtanimator.document.loaders`, whose ``load_runtime`` is this one."""
     loader = _LOADERS.get(asset.kind)
     return loader(asset) if loader is not None else None
-
-
-def _ensure_builtin_loaders() -> None:
-    # Imported on first use: the loaders pull in every engine, which a plain
-    # ``import qtanimator.document`` should not pay for.
-    import qtanimator.document.loaders  # noqa: F401

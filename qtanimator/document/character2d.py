@@ -52,7 +52,14 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Key
-from qtanimator.core.pendulum import PRESETS, PendulumBlowUp, PendulumParams, PendulumSystem, check_state
+from qtanimator.core.pendulum import (
+    PRESETS,
+    PendulumBlowUp,
+    PendulumParams,
+    PendulumSystem,
+    check_state,
+    rotation_pivot_terms,
+)
 from qtanimator.core.rig2d import Character, Pose, angle_sums
 from qtanimator.core.spring_joint import SPRING_PRESETS, SpringParams, SpringSystem
 from qtanimator.document.commands import AddAsset, Command, DeleteKeys, Macro, SetKeys, SetParameter
@@ -67,8 +74,8 @@ from qtanimator.document.document import (
 from qtanimator.document.ik_settings import IK_DEFAULTS as IK_DEFAULTS
 from qtanimator.document.ik_settings import ik_setting as ik_setting
 from qtanimator.document.ik_settings import solve_character
+from qtanimator.document.pending_pose import pending_value, pending_values
 from qtanimator.document.placement import PLACEMENT, matrix2d
-from qtanimator.document.pose import pending_value, pending_values
 from qtanimator.document.simulation import SimulationWorker, ui_idle
 
 ASSET_KIND = "character2d"
@@ -593,7 +600,7 @@ def set_spring_preset(doc: Document, asset_id: str, name: str) -> Command:
     return _preset_command(doc, f"{asset_id}.spring.", SPRING_PRESETS, name, "Spring")
 
 
-def _keyed_angles_at(channels: dict[str, Channel], asset_id: str, ch: Character, times: FloatArray,
+def _keyed_angles_at(channels: Mapping[str, Channel], asset_id: str, ch: Character, times: FloatArray,
                      limits: list[tuple[float, float] | None]) -> FloatArray:
     """(3, len(times), J): every non-dynamic joint's keyed local angle, rate and acceleration
     at ``times``, clamped to its limits (still while clamped), as ``_advance`` reads them."""
@@ -1154,12 +1161,8 @@ class PendulumCache:
             if len(sim.pair_anc):
                 world = w_key[s] + sim.dyn_pick @ theta
                 rate = r_key[s] + sim.dyn_pick @ omega
-                th = world[sim.pair_anc]
-                c, sn = np.cos(th), np.sin(th)
-                v = sim.pair_vec
-                rv = np.stack([c * v[:, 0] + sn * v[:, 1], -sn * v[:, 0] + c * v[:, 1]], axis=1)
-                jrv = np.stack([rv[:, 1], -rv[:, 0]], axis=1)
-                contrib = rs * (a_key[s][sim.pair_anc][:, None] * jrv - (rate[sim.pair_anc] ** 2)[:, None] * rv)
+                contrib = rotation_pivot_terms(world[sim.pair_anc], rate[sim.pair_anc], a_key[s][sim.pair_anc],
+                                               sim.pair_vec, rs)
                 pa[sim.tops] = tacc[s] + sim.pair_sum @ contrib
             else:
                 pa[sim.tops] = tacc[s]
@@ -1213,6 +1216,14 @@ def simulation(doc: Document) -> PendulumCache:
         cache = PendulumCache(doc)
         doc.caches[PENDULUM_CACHE] = cache
     return cache
+
+
+def ensure_caches(doc: Document) -> None:
+    """Create ``doc``'s simulation caches now. An editor context calls it before it
+    subscribes to the document, so that the caches drop what a change invalidates before any
+    view hears of the change (listeners are told in the order they subscribed). The cloth
+    caches live in ``doc.runtime`` and subscribe through their worker."""
+    simulation(doc)
 
 
 def simulation_ready(doc: Document, times: float | Iterable[float]) -> bool:

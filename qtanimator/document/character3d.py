@@ -4,7 +4,7 @@ An asset of kind :data:`ASSET_KIND` has the ``.skel`` file as its ``source`` and
 optional properties ``skin_file`` and ``anim_file`` (CSE 169) or ``obj_file`` and
 ``attach_file`` (MIT 6.837). The source may also be a ``.bvh`` file (skeleton with one
 rotation order per joint; its motion lives in the document's channels) or a ``.glb`` /
-``.gltf`` file (see :mod:`qtanimator.document.import3d`). The loaded :class:`Character3D`
+``.gltf`` file (see :mod:`qtanimator.document.gltf_character`). The loaded :class:`Character3D`
 lives in ``doc.runtime``.
 
 Channels (document channel ids):
@@ -42,7 +42,7 @@ import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Interpolation, Key, Tangent
 from qtanimator.core.clip import ROOT, AnimationClip, channel_count, channel_target
-from qtanimator.core.quaternion_channels import QUATERNION_DOFS, euler_channels, quaternion_at, quaternion_channels
+from qtanimator.core.quaternion_channels import euler_channels, quaternion_at, quaternion_channels
 from qtanimator.core.rotation import euler_to_quaternions, quaternions_to_euler, same_hemisphere
 from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skeleton, axis_index
 from qtanimator.core.skinning import (
@@ -52,6 +52,23 @@ from qtanimator.core.skinning import (
     skin_positions,
     skin_positions_and_normals,
     vertex_normals,
+)
+from qtanimator.document.character3d_model import (
+    ASSET_KIND,
+    CLIP,
+    CLIP_STORE,
+    JOINT_DOFS,
+    QUAT_DOFS,
+    ROOT_DOFS,
+    ROTATION_MODE,
+    ROTATION_MODES,
+    SCALE_DOFS,
+    TRANSLATE_DOFS,
+    Character3D,
+    ClipSource,
+    MeshPart,
+    TextureImage,
+    skin_texture,
 )
 from qtanimator.document.commands import (
     AddAsset,
@@ -63,8 +80,9 @@ from qtanimator.document.commands import (
     SetParameter,
 )
 from qtanimator.document.document import Asset, Document, channel_id
+from qtanimator.document.gltf_character import load_gltf_character_asset
+from qtanimator.document.pending_pose import pending_values
 from qtanimator.document.placement import PLACEMENT, matrix3d
-from qtanimator.document.pose import pending_values
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.attach import load_attach
 from qtanimator.formats.bvh import POSITION_CONVENTIONS, load_bvh
@@ -75,19 +93,6 @@ from qtanimator.formats.skin import load_skin
 
 FloatArray = npt.NDArray[np.float64]
 
-ASSET_KIND = "character3d"
-ROOT_DOFS = ("tx", "ty", "tz")
-JOINT_DOFS = ("rx", "ry", "rz")
-QUAT_DOFS = QUATERNION_DOFS
-TRANSLATE_DOFS = ("tx", "ty", "tz")
-SCALE_DOFS = ("sx", "sy", "sz")
-#: The asset properties of the active clip's name and of the clips edited and left.
-CLIP = "clip"
-CLIP_STORE = "clip_store"
-#: The asset property saying how rotations are keyed: "quaternion" or "euler" (absent: as
-#: the file has them; glTF quaternion, the others Euler).
-ROTATION_MODE = "rotation_mode"
-ROTATION_MODES = ("quaternion", "euler")
 
 __all__ = [
     "ASSET_KIND", "BVH_POSITIONS", "BvhCharacter", "CLIP", "CLIP_STORE", "Character3D", "ClipSource", "MeshPart",
@@ -100,126 +105,6 @@ __all__ = [
     "set_rotation_mode_command", "skin_texture", "skinned_mesh", "with_rotation_mode", "world_matrices",
 ]
 
-
-@dataclass(eq=False)
-class TextureImage:
-    """An image a mesh is drawn with, as the file gave it: its bytes (a glTF embedded image)
-    or a ``path`` (a ``.skin`` material's texture beside the skin, a glTF ``uri``). The render
-    layer decodes it; undecodable or missing, it draws a checkerboard. ``wrap`` is
-    ``"repeat"`` or ``"clamp"`` (to the edge)."""
-
-    data: bytes | None = None
-    path: str | None = None
-    mime_type: str | None = None
-    name: str = ""
-    wrap: str = "repeat"
-
-    def read(self) -> bytes | None:
-        """The image's bytes (None when the file is missing or unreadable)."""
-        if self.data is not None:
-            return self.data
-        if self.path is None:
-            return None
-        try:
-            return Path(self.path).read_bytes()
-        except OSError:
-            return None
-
-
-def skin_texture(skin: Skin | None, skin_path: str | os.PathLike[str] | None) -> TextureImage | None:
-    """The image of a ``.skin``'s ``material { texture FILE }`` block: FILE beside the skin
-    (matched without regard to case when the exact name is absent). None without a block."""
-    material = getattr(skin, "material", None)
-    name = material.get("texture") if material else None
-    if not name or skin_path is None:
-        return None
-    folder = Path(skin_path).parent
-    path = folder / str(name)
-    if not path.is_file() and folder.is_dir():
-        path = next((p for p in sorted(folder.iterdir()) if p.name.lower() == Path(str(name)).name.lower()), path)
-    return TextureImage(path=str(path), name=str(name), wrap="clamp")
-
-
-@dataclass
-class MeshPart:
-    """One mesh of a character: vertices ``start … start + count`` and triangles
-    ``triangle_start …`` of the merged skin. ``node`` / ``mesh`` / ``primitive`` say where
-    it came from in a glTF file (None for course files)."""
-
-    name: str
-    start: int
-    count: int
-    triangle_start: int = 0
-    triangle_count: int = 0
-    skinned: bool = True
-    node: int | None = None
-    mesh: int | None = None
-    primitive: int = 0
-    #: base colour (RGBA, linear) of the part's material
-    color: tuple[float, float, float, float] = (0.8, 0.8, 0.8, 1.0)
-    #: the image of the material's base colour (drawn with the skin's texture coordinates)
-    texture: TextureImage | None = None
-
-
-@dataclass
-class ClipSource:
-    """An animation the character's file brought: its name, where it lies in the file's
-    time, and its channels keyed by the asset-relative id (``"<joint key>/<dof>"``,
-    ``"/tx"`` for the root translation)."""
-
-    name: str
-    start: float
-    end: float
-    channels: dict[str, Channel] = field(default_factory=dict)
-    #: the animation's index in the file (None: not from a file)
-    index: int | None = None
-
-
-@dataclass(eq=False)
-class Character3D:
-    """What a 3D character asset loads: skeleton (rest pose from the file), skin, clip."""
-
-    skeleton: Skeleton
-    skin: Skin | None = None
-    mesh: Mesh | None = None
-    clip: AnimationClip | None = None
-    #: MIT meshes are drawn with per-face normals by default.
-    faceted: bool = False
-    #: The meshes of the merged skin (empty: the skin is one mesh).
-    parts: list[MeshPart] = field(default_factory=list)
-    #: The animations of the file (glTF); the document's channels hold the active one.
-    clips: list[ClipSource] = field(default_factory=list)
-    #: Skin joint slot → skeleton joint (None: slot i is joint i). Several glTF skins (each
-    #: with its own inverse bind matrices) and rigid parts share one merged skin this way.
-    palette: npt.NDArray[np.intp] | None = None
-    #: Notes for the user from reading the file.
-    notes: list[str] = field(default_factory=list)
-    #: The whole skin's image when it has no parts (a ``.skin`` material's texture).
-    texture: TextureImage | None = None
-    _rest_quaternions: FloatArray | None = field(default=None, repr=False)
-
-    @property
-    def joint_keys(self) -> list[str]:
-        return self.skeleton.joint_keys()
-
-    def skinning_world(self, world: FloatArray) -> FloatArray:
-        """The world matrices of the skin's joint slots from the skeleton's (J, 4, 4)."""
-        return world if self.palette is None else world[self.palette]
-
-    def clip_named(self, name: str) -> ClipSource | None:
-        return next((c for c in self.clips if c.name == name), None)
-
-    def rest_quaternions(self) -> FloatArray:
-        """(J, 4) the rest pose's rotations as quaternions (what a quaternion joint holds
-        where a component has no channel)."""
-        if self._rest_quaternions is None:
-            sk = self.skeleton
-            out = np.tile(np.array([0.0, 0.0, 0.0, 1.0]), (len(sk.joints), 1))
-            for i, j in enumerate(sk.joints):
-                if j.quaternion:
-                    out[i] = euler_to_quaternions(j.pose, j.rotation_order or sk.rotation_order)[0]
-            self._rest_quaternions = out
-        return self._rest_quaternions
 
 
 def load_character3d(skel_path: str | os.PathLike[str], skin_path: str | os.PathLike[str] | None = None,
@@ -397,8 +282,6 @@ def _load_character3d_asset(asset: Asset) -> Character3D:
     if suffix == ".skin":
         return load_skin_character(asset.source)
     if suffix in (".glb", ".gltf"):
-        from qtanimator.document.import3d import load_gltf_character_asset
-
         return load_gltf_character_asset(asset)
     p = asset.properties
     return load_character3d(asset.source, p.get("skin_file") or None, p.get("anim_file") or None,

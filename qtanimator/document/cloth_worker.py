@@ -447,13 +447,15 @@ class LiveCloths:
     def sync(self, doc: Document) -> None:
         """Create live cloths for new cloth assets, drop removed ones, follow parameter edits."""
         wanted: dict[str, ClothParams] = {}
+        invalid: dict[str, str] = {}
         for aid, asset in doc.assets.items():
             if asset.kind != ASSET_KIND:
                 continue
             try:
                 wanted[aid] = cloth_params(doc, aid)
-            except (ValueError, TypeError, KeyError):
-                wanted[aid] = ClothParams()
+            except (ValueError, TypeError, KeyError) as exc:
+                # no live cloth with made-up parameters: the Cloth dock shows why there is none
+                invalid[aid] = f"invalid parameters: {exc}"
         fresh = {aid: Cloth(p) for aid, p in wanted.items() if aid not in self.cloths}
 
         def apply() -> None:
@@ -461,10 +463,12 @@ class LiveCloths:
                 del self.cloths[aid]
                 self._frames.pop(aid, None)
                 self.errors.pop(aid, None)
+            self.errors.update(invalid)
             for aid, params in wanted.items():
                 cloth = self.cloths.get(aid)
                 if cloth is None:
                     self.cloths[aid] = fresh.get(aid) or Cloth(params)
+                    self.errors.pop(aid, None)
                 elif cloth.params != params:
                     cloth.set_params(params)
                     self.errors.pop(aid, None)

@@ -17,6 +17,7 @@ from typing import Any
 
 from qtanimator.core.channel import Channel, Extrapolation, Key, Tangent
 from qtanimator.document.document import Asset, Document
+from qtanimator.document.parameters import validate_parameter
 
 
 class Command:
@@ -236,10 +237,18 @@ class SetParameter(Command):
 
     Without a ``gesture`` every set is its own undo step (typing 24 then 30 into the fps
     field is two steps); a slider passes one token per drag.
+
+    A value for a path the parameter schema knows (:func:`qtanimator.document.parameters.param_for`:
+    the project, IK, light, pendulum and spring settings) is validated here: one it refuses
+    raises ValueError naming the setting and its range, and nothing is done. None (unset)
+    is always allowed. ``validate=False`` skips the check (tests that store what a
+    hand-written project file could hold).
     """
 
     def __init__(self, doc: Document, path: str, value: Any, text: str | None = None,
-                 gesture: Hashable | None = None) -> None:
+                 gesture: Hashable | None = None, *, validate: bool = True) -> None:
+        if validate:
+            validate_parameter(path, value)
         self.path = path
         self.old = doc.parameters.get(path)
         self.new = value

@@ -2,7 +2,10 @@
 
 The document is plain data plus change notification. Only commands
 (:mod:`qtanimator.document.commands`) call the mutating methods whose names start with
-``apply_``; widgets read the document and subscribe to its events.
+``apply_``; widgets read the document and subscribe to its events. :attr:`Document.channels`
+and :attr:`Document.parameters` are read-only views (``dict(doc.channels)`` for a copy);
+set up a document's content through commands (``SetChannels(...).do(doc)``) or, when
+loading, through the constructor.
 
 Vocabulary
 ----------
@@ -28,15 +31,13 @@ from types import MappingProxyType
 from typing import Any
 
 from qtanimator.core.channel import Channel
+from qtanimator.document.parameters import PROJECT, defaults
 
-DEFAULT_FPS = 60.0
+DEFAULT_FPS = float(PROJECT["fps"].default)
 
-#: Parameters every document has, with their defaults.
-PROJECT_DEFAULTS: dict[str, Any] = {
-    "fps": DEFAULT_FPS,
-    "frame_start": 0,
-    "frame_end": 240,
-}
+#: Parameters every document has, with their defaults (a view of the schema,
+#: :data:`qtanimator.document.parameters.PROJECT`, which also holds their ranges).
+PROJECT_DEFAULTS: dict[str, Any] = defaults(PROJECT)
 
 
 def channel_id(asset: str, joint: str, dof: str) -> str:
@@ -133,10 +134,13 @@ Listener = Callable[[DocumentChange], None]
 class Document:
     """The one document every editor shows."""
 
-    def __init__(self) -> None:
+    def __init__(self, *, channels: Mapping[str, Channel] | None = None,
+                 parameters: Mapping[str, Any] | None = None) -> None:
+        """A new document; ``channels`` and ``parameters`` are its initial content (what a
+        loader read; the parameters default to :data:`PROJECT_DEFAULTS`, which fill in any
+        missing). After that only commands change them (the ``apply_*`` methods)."""
         self.assets: dict[str, Asset] = {}
-        self.channels: dict[str, Channel] = {}
-        self.parameters: dict[str, Any] = dict(PROJECT_DEFAULTS)
+        self._set_content(dict(channels or {}), {**PROJECT_DEFAULTS, **(parameters or {})})
         self.runtime: dict[str, Any] = {}
         #: View state such as the 3D camera: saved with the project, never an edit (no
         #: command, no undo step, not part of :meth:`state`). See :meth:`set_view_state`.
@@ -195,6 +199,34 @@ class Document:
 
     # ------------------------------------------------------------------ reads
     @property
+    def channels(self) -> Mapping[str, Channel]:
+        """Channel id → :class:`Channel`, read only (a live view: commands change it)."""
+        return self._channels_view
+
+    @property
+    def parameters(self) -> Mapping[str, Any]:
+        """Dotted path → JSON value, read only (a live view: commands change it)."""
+        return self._parameters_view
+
+    def _set_content(self, channels: dict[str, Channel], parameters: dict[str, Any]) -> None:
+        # The private dicts are written only by the apply_* methods (and here); readers get
+        # views made once, so a read costs a dict look-up, never a copy.
+        self._channels = channels
+        self._parameters = parameters
+        self._channels_view: Mapping[str, Channel] = MappingProxyType(channels)
+        self._parameters_view: Mapping[str, Any] = MappingProxyType(parameters)
+
+    def __getstate__(self) -> dict[str, Any]:
+        # the views do not pickle (copy.copy and pickle go through here); they are rebuilt
+        state = dict(self.__dict__)
+        del state["_channels_view"], state["_parameters_view"]
+        return state
+
+    def __setstate__(self, state: dict[str, Any]) -> None:
+        self.__dict__.update(state)
+        self._set_content(self._channels, self._parameters)
+
+    @property
     def fps(self) -> float:
         return float(self.parameters.get("fps", DEFAULT_FPS))
 
@@ -229,17 +261,17 @@ class Document:
     def apply_channel(self, cid: str, channel: Channel | None, time_from: float = -math.inf) -> None:
         """Set (or with None remove) one channel and announce it."""
         if channel is None:
-            self.channels.pop(cid, None)
+            self._channels.pop(cid, None)
         else:
-            self.channels[cid] = channel
+            self._channels[cid] = channel
         self.emit(DocumentChange(channels=MappingProxyType({cid: time_from})))
 
     def apply_parameter(self, path: str, value: Any) -> None:
         """Set (or with None remove) one parameter and announce it."""
         if value is None:
-            self.parameters.pop(path, None)
+            self._parameters.pop(path, None)
         else:
-            self.parameters[path] = value
+            self._parameters[path] = value
         self.emit(DocumentChange(parameters=frozenset((path,))))
 
     def apply_asset(self, asset_id: str, asset: Asset | None, runtime: Any = None,
@@ -266,8 +298,7 @@ class Document:
     def replace_all(self, other: Document) -> None:
         """Take over another document's content (used by File > Open and New)."""
         self.assets = other.assets
-        self.channels = other.channels
-        self.parameters = other.parameters
+        self._set_content(other._channels, other._parameters)
         self.runtime = other.runtime
         self.view_state = other.view_state
         self.path = other.path
@@ -284,7 +315,7 @@ class Document:
                 for a in self.assets.values()
             ],
             "channels": {cid: ch.to_dict() for cid, ch in self.channels.items()},
-            "parameters": _deep_copy(self.parameters),
+            "parameters": _deep_copy(self._parameters),
         }
 
 

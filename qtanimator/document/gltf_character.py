@@ -44,7 +44,7 @@ from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key
 from qtanimator.core.rotation import euler_from_matrices, matrices_to_quaternions, polar, quaternion_to_matrix
 from qtanimator.core.skeleton import DEFAULT_BOXMAX, DEFAULT_BOXMIN, Joint, Skeleton
 from qtanimator.core.skinning import Skin, SkinBinding, vertex_normals
-from qtanimator.document.character3d import (
+from qtanimator.document.character3d_model import (
     QUAT_DOFS,
     SCALE_DOFS,
     TRANSLATE_DOFS,
@@ -53,7 +53,10 @@ from qtanimator.document.character3d import (
     MeshPart,
     TextureImage,
 )
-from qtanimator.formats.gltf import GltfAnimation, GltfSampler, GltfScene
+from qtanimator.document.document import Asset
+from qtanimator.formats.errors import FormatError
+from qtanimator.formats.gltf.model import GltfAnimation, GltfSampler, GltfScene
+from qtanimator.formats.gltf.reader import import_gltf
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -379,3 +382,10 @@ def _merged_skin(scene: GltfScene, joint_of: dict[int, int], notes: list[str],
 def clip_summary(ch: Character3D) -> list[dict[str, Any]]:
     """Name, start and end of each clip (for notes and the info command)."""
     return [{"name": c.name, "start": c.start, "end": c.end} for c in ch.clips]
+
+
+def load_gltf_character_asset(asset: Asset) -> Character3D:
+    """The runtime of a character whose source is a ``.glb`` / ``.gltf`` (a project being opened)."""
+    if not asset.source:
+        raise FormatError(f"3D character {asset.id!r} has no source file.")
+    return character_from_gltf(import_gltf(asset.source), asset.source).character

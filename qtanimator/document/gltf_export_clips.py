@@ -37,7 +37,7 @@ from qtanimator.core.channel import Channel, Extrapolation, Interpolation
 from qtanimator.core.quaternion_channels import quaternions_at
 from qtanimator.core.rotation import euler_to_quaternions
 from qtanimator.core.skeleton import Joint
-from qtanimator.document.character3d import (
+from qtanimator.document.character3d_model import (
     JOINT_DOFS,
     QUAT_DOFS,
     ROOT_DOFS,
@@ -46,7 +46,8 @@ from qtanimator.document.character3d import (
     Character3D,
 )
 from qtanimator.document.document import channel_id
-from qtanimator.formats.gltf import GltfAnimation, GltfAnimationChannel, GltfSampler, sample_times
+from qtanimator.formats.gltf.model import GltfAnimation, GltfAnimationChannel, GltfSampler
+from qtanimator.formats.gltf.sampling import sample_times
 
 FloatArray = npt.NDArray[np.float64]
 

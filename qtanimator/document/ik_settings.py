@@ -1,7 +1,7 @@
 """The document's IK settings and the solver they pick, for 2D characters and 3D skeletons.
 
-Settings are document parameters ``ik.*`` (defaults in :data:`IK_DEFAULTS`, edited in the
-Properties dock, saved with the project):
+Settings are document parameters ``ik.*`` (defaults in :data:`IK_DEFAULTS`, from the schema
+:data:`qtanimator.document.parameters.IK`; edited in the Properties dock, saved with the project):
 
 * ``ik.solver``: ``"dls"`` (damped least squares, the default), ``"ccd"``, ``"fabrik"`` or
   ``"handout"`` (the course handout's gradient descent; 2D only, 3D uses ``dls`` for it);
@@ -30,23 +30,14 @@ from qtanimator.core import ik, ik3d, ik3d_methods, ik_methods
 from qtanimator.core.rig2d import Character
 from qtanimator.core.skeleton import Skeleton
 from qtanimator.document.document import Document
+from qtanimator.document.parameters import IK, IK_SOLVERS, defaults
 
 FloatArray = npt.NDArray[np.float64]
 
-#: IK settings: document parameters with their defaults.
-IK_DEFAULTS: dict[str, Any] = {
-    "ik.solver": "dls",
-    "ik.two_bone": True,
-    "ik.bend_direction": "keep",
-    "ik.freeze_root": True,
-    "ik.max_iterations": 100,
-    "ik.damping": 1e-3,
-    "ik.handout_step": 1e-6,
-    "ik.handout_iterations": 10,
-    "ik.gradient_arrow_scale": 0.1,
-}
-#: The values ``ik.solver`` takes.
-IK_SOLVERS = ("dls", "ccd", "fabrik", "handout")
+#: IK settings: document parameters with their defaults (a view of the schema,
+#: :data:`qtanimator.document.parameters.IK`, which also holds their ranges and labels).
+IK_DEFAULTS: dict[str, Any] = defaults(IK)
+#: The values ``ik.solver`` takes: ``IK_SOLVERS`` (imported from the schema).
 #: The values ``ik.bend_direction`` takes.
 BEND_DIRECTIONS = ik_methods.BEND_DIRECTIONS
 #: 3D tolerance (scene units) for CCD and FABRIK, as the DLS solver's default.

@@ -61,12 +61,18 @@ from qtanimator.document.character3d import (
 )
 from qtanimator.document.commands import AddAsset, Command, Macro, SetParameter
 from qtanimator.document.document import Asset, Document
-from qtanimator.document.gltf_character import GLTF_ROTATION_ORDER, character_from_gltf
+from qtanimator.document.gltf_character import (
+    GLTF_ROTATION_ORDER,
+    character_from_gltf,
+    load_gltf_character_asset,
+)
 from qtanimator.document.gltf_export import character_scene
 from qtanimator.document.placement import CHARACTER_HEIGHT, FAR_FROM_UNIT, GAP, PLACEMENT
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.errors import FormatError
-from qtanimator.formats.gltf import CharacterExport, export_glb, import_gltf
+from qtanimator.formats.gltf.character import CharacterExport
+from qtanimator.formats.gltf.reader import import_gltf
+from qtanimator.formats.gltf.writer import export_glb
 from qtanimator.formats.skel import load_skel
 from qtanimator.formats.skin import load_skin
 
@@ -402,13 +408,6 @@ def _asset_base(p: Path) -> str:
 
 
 # --------------------------------------------------------------------------- glTF
-def load_gltf_character_asset(asset: Asset) -> Character3D:
-    """The runtime of a character whose source is a ``.glb`` / ``.gltf`` (a project being opened)."""
-    if not asset.source:
-        raise FormatError(f"3D character {asset.id!r} has no source file.")
-    return character_from_gltf(import_gltf(asset.source), asset.source).character
-
-
 def _animated_elsewhere(doc: Document) -> bool:
     """Whether the document has keys on any channel (its range is someone's choice)."""
     return any(c.keys for c in doc.channels.values())

@@ -13,10 +13,10 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Any
 
 from qtanimator.document.asset_files import FileRef, find_beside, missing_refs
-from qtanimator.document.assets import load_runtime
-from qtanimator.document.document import PROJECT_DEFAULTS, Asset, Document
+from qtanimator.document.document import Asset, Document
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.project import AssetRecord, ProjectData, load_project, save_project
 
@@ -31,29 +31,36 @@ def to_project_data(doc: Document) -> ProjectData:
     nothing and keeps that a convention, not a requirement).
     """
     return ProjectData(
-        parameters=copy.deepcopy(doc.parameters),
+        parameters=copy.deepcopy(dict(doc.parameters)),
         view=copy.deepcopy(doc.view_state),
         assets=[AssetRecord(a.id, a.kind, a.source, copy.deepcopy(a.properties)) for a in doc.assets.values()],
         channels=dict(doc.channels),
     )
 
 
+def _load_runtime(asset: Asset) -> Any:
+    """:func:`qtanimator.document.loaders.load_runtime`, imported on the first open: the
+    loaders pull in every engine, which a plain ``import qtanimator.document`` should not pay
+    for. (Nothing those import imports this module: no cycle.)"""
+    from qtanimator.document.loaders import load_runtime
+
+    return load_runtime(asset)
+
+
 def document_from_project_data(data: ProjectData) -> Document:
     """Build a document and load every asset's source (FormatError if one fails)."""
-    doc = Document()
-    doc.parameters = {**PROJECT_DEFAULTS, **data.parameters}
+    doc = Document(channels=data.channels, parameters=data.parameters)  # defaults fill in the rest
     doc.view_state = dict(data.view)
     for rec in data.assets:
         asset = Asset(rec.id, rec.kind, rec.source, dict(rec.properties))
         doc.assets[asset.id] = asset
         try:
-            runtime = load_runtime(asset)
+            runtime = _load_runtime(asset)
         except OSError as exc:  # a loader that let a missing or unreadable file through
             raise FormatError(f"asset {asset.id!r}: cannot read {exc.filename or asset.source!r} "
                               f"({exc.strerror or exc}).", rec.source) from exc
         if runtime is not None:
             doc.runtime[asset.id] = runtime
-    doc.channels = dict(data.channels)
     return doc
 
 

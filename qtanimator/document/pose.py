@@ -41,23 +41,28 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
-from types import MappingProxyType
-from typing import Any
 
 import numpy as np
 
 from qtanimator.core.channel import Key
+from qtanimator.core.rig2d import Character
+from qtanimator.core.skeleton import Skeleton
+from qtanimator.document import character2d as c2d
+from qtanimator.document import character3d as c3d
 from qtanimator.document.commands import Command, SetKeys
-from qtanimator.document.document import Document, DocumentChange, channel_id
+from qtanimator.document.document import Document, channel_id
+from qtanimator.document.pending_pose import (
+    PENDING_CHANGE,
+    PendingPose,
+    PosePreview,
+    clear_pending,
+    has_pending,
+    pending_store,
+    pending_value,
+    pending_values,
+)
 
 AUTOKEY_VIEW_STATE = "animation.autokey"
-#: The pseudo parameter a change of the pending pose announces (not a real parameter).
-PENDING_CHANGE = "pose.pending"
-PENDING_CACHE = "pose.pending"
-#: Two times closer than this are the same frame.
-TIME_TOLERANCE = 1e-9
-
-_EMPTY: Mapping[str, float] = MappingProxyType({})
 
 
 # ---------------------------------------------------------------------- auto-key
@@ -71,154 +76,9 @@ def set_autokey(doc: Document, on: bool) -> None:
     doc.set_view_state(AUTOKEY_VIEW_STATE, bool(on))
 
 
-# ------------------------------------------------------------------ pending pose
-Entry = tuple[float, Any]
-State = tuple["float | None", dict[str, Entry]]
-
-
-class PendingPose:
-    """Channel values shown at one time without keys (see the module's docstring).
-
-    Each value remembers the channel object it was posed over (channels are immutable:
-    every edit makes a new one). A value counts only while its channel is still that
-    object: keying it, an edit in another editor or an undo ends it at once — and an
-    undo that puts the very channel back (Escape on a drag, undoing set key) shows the
-    unkeyed value again, as it was before.
-    """
-
-    def __init__(self, doc: Document) -> None:
-        self.time: float | None = None
-        self.entries: dict[str, Entry] = {}
-        doc.subscribe(self._on_change)
-
-    def _here(self, time: float) -> bool:
-        return self.time is not None and bool(self.entries) and abs(time - self.time) <= TIME_TOLERANCE
-
-    def value(self, doc: Document, cid: str, time: float) -> float | None:
-        if not self._here(time):
-            return None
-        entry = self.entries.get(cid)
-        if entry is None or doc.channels.get(cid) is not entry[1]:
-            return None
-        return entry[0]
-
-    def at(self, doc: Document, time: float) -> dict[str, float]:
-        if not self._here(time):
-            return {}
-        channels = doc.channels
-        return {cid: v for cid, (v, ch) in self.entries.items() if channels.get(cid) is ch}
-
-    def snapshot(self) -> State:
-        return self.time, dict(self.entries)
-
-    def restore(self, state: State) -> None:
-        time, entries = state
-        self.entries = dict(entries)
-        self.time = time if self.entries else None
-
-    def _on_change(self, change: DocumentChange) -> None:
-        if change.reset and self.entries:
-            self.restore((None, {}))
-
-
-def pending_store(doc: Document) -> PendingPose:
-    """The document's pending pose (created on first use)."""
-    store = doc.caches.get(PENDING_CACHE)
-    if not isinstance(store, PendingPose):
-        store = PendingPose(doc)
-        doc.caches[PENDING_CACHE] = store
-    return store
-
-
-def pending_values(doc: Document, time: float) -> Mapping[str, float]:
-    """The pending channel values at ``time`` (empty unless a pose is pending there)."""
-    store = doc.caches.get(PENDING_CACHE)
-    if store is None:
-        return _EMPTY
-    return store.at(doc, time)
-
-
-def pending_value(doc: Document, cid: str, time: float) -> float | None:
-    """One channel's pending value at ``time``, or None."""
-    store = doc.caches.get(PENDING_CACHE)
-    if store is None:
-        return None
-    return store.value(doc, cid, time)
-
-
-def has_pending(doc: Document, time: float | None = None) -> bool:
-    """True when a pose is pending (at ``time`` when given)."""
-    store = doc.caches.get(PENDING_CACHE)
-    if not isinstance(store, PendingPose) or store.time is None:
-        return False
-    return bool(store.at(doc, store.time if time is None else time))
-
-
-def _announce(doc: Document) -> None:
-    doc.emit(DocumentChange(parameters=frozenset((PENDING_CHANGE,))))
-
-
-def clear_pending(doc: Document) -> bool:
-    """Drop the pending pose (the frame changed). True (and announced) if one was shown."""
-    store = doc.caches.get(PENDING_CACHE)
-    if not isinstance(store, PendingPose) or not store.entries:
-        return False
-    shown = has_pending(doc)
-    store.restore((None, {}))
-    if shown:
-        _announce(doc)
-    return shown
-
-
-class PosePreview(Command):
-    """Pose without keying: set pending values at a time. Never an undo step
-    (:meth:`is_noop`), so a drag with auto-key off records nothing; ``undo`` puts the
-    pending pose back as it was (Escape during the drag)."""
-
-    def __init__(self, doc: Document, values: Mapping[str, float], time: float, text: str = "Pose",
-                 gesture: Any = None) -> None:
-        store = pending_store(doc)
-        self.text = text
-        self.gesture = gesture
-        self.old = store.snapshot()
-        entries = {cid: e for cid, e in store.entries.items() if store.value(doc, cid, time) is not None}
-        for cid, v in values.items():
-            entries[cid] = (float(v), doc.channels.get(cid))
-        self.new: State = (float(time), entries)
-
-    def do(self, doc: Document) -> None:
-        pending_store(doc).restore(self.new)
-        _announce(doc)
-
-    def undo(self, doc: Document) -> None:
-        pending_store(doc).restore(self.old)
-        _announce(doc)
-
-    def merge(self, other: Command) -> bool:
-        if self.gesture is None or other.gesture != self.gesture or not isinstance(other, PosePreview):
-            return False
-        self.new = other.new
-        return True
-
-    def is_noop(self) -> bool:
-        return True
-
-
 # ------------------------------------------------------------------ the shown pose
 def _kind(doc: Document, asset_id: str) -> str:
     return doc.assets[asset_id].kind
-
-
-def _c2d() -> Any:
-    from qtanimator.document import character2d
-
-    return character2d
-
-
-def _c3d() -> Any:
-    from qtanimator.document import character3d
-
-    return character3d
 
 
 def shown_values_2d(doc: Document, asset_id: str, time: float,
@@ -227,7 +87,6 @@ def shown_values_2d(doc: Document, asset_id: str, time: float,
     keyframed joints' local angles and the position from the channels and the pending
     pose; dynamic joints' world angles from the exact simulation — run only when one of
     them is asked for."""
-    c2d = _c2d()
     ch = c2d.character(doc, asset_id)
     wanted = None if cids is None else set(cids)
     ids = [c2d.angle_channel_id(asset_id, j.name) for j in ch.joints]
@@ -249,15 +108,15 @@ def shown_values_2d(doc: Document, asset_id: str, time: float,
 
 def shown_values_3d(doc: Document, asset_id: str, time: float) -> dict[str, float]:
     """Every DOF channel value of a 3D character as shown at ``time`` (clamped)."""
-    return _c3d().pose_channel_values(doc, asset_id, time)
+    return c3d.pose_channel_values(doc, asset_id, time)
 
 
 def shown_values(doc: Document, asset_id: str, time: float, cids: Iterable[str] | None = None) -> dict[str, float]:
     """The channel values of a character as shown at ``time`` (pending or evaluated)."""
     kind = _kind(doc, asset_id)
-    if kind == _c2d().ASSET_KIND:
+    if kind == c2d.ASSET_KIND:
         return shown_values_2d(doc, asset_id, time, cids)
-    if kind == _c3d().ASSET_KIND:
+    if kind == c3d.ASSET_KIND:
         return shown_values_3d(doc, asset_id, time)
     raise KeyError(f"{asset_id} is not a character")
 
@@ -266,15 +125,13 @@ def joint_channels(doc: Document, asset_id: str, joint: str) -> list[str]:
     """The channels set key keys for a selection: a joint's rotation channel(s); with
     ``joint`` "" (the character selected) its root joint and its position."""
     kind = _kind(doc, asset_id)
-    if kind == _c2d().ASSET_KIND:
-        c2d = _c2d()
+    if kind == c2d.ASSET_KIND:
         ch = c2d.character(doc, asset_id)
         if not joint:
             return [c2d.angle_channel_id(asset_id, ch.joints[0].name), *c2d.position_channel_ids(asset_id)]
         ch.joint_index(joint)  # KeyError for an unknown joint
         return [c2d.angle_channel_id(asset_id, joint)]
-    if kind == _c3d().ASSET_KIND:
-        c3d = _c3d()
+    if kind == c3d.ASSET_KIND:
         skel = c3d.character(doc, asset_id).skeleton
         keys = skel.joint_keys()
         index = keys.index(joint) if joint else 0
@@ -289,13 +146,12 @@ def character_channels(doc: Document, asset_id: str) -> list[str]:
     """The channels "key the whole character" keys: 2D every keyframed (non-pendulum)
     joint and the position; 3D every DOF."""
     kind = _kind(doc, asset_id)
-    if kind == _c2d().ASSET_KIND:
-        c2d = _c2d()
+    if kind == c2d.ASSET_KIND:
         ch = c2d.character(doc, asset_id)
         ids = [c2d.angle_channel_id(asset_id, j.name) for j in ch.joints if not j.is_dynamic]
         return ids + list(c2d.position_channel_ids(asset_id))
-    if kind == _c3d().ASSET_KIND:
-        return list(_c3d().all_channel_ids(doc, asset_id))
+    if kind == c3d.ASSET_KIND:
+        return list(c3d.all_channel_ids(doc, asset_id))
     raise KeyError(f"{asset_id} is not a character")
 
 
@@ -304,8 +160,8 @@ def key_channels_command(doc: Document, asset_id: str, cids: Iterable[str], time
     """Key the shown values of ``cids`` at ``time`` (one undo step)."""
     cids = list(cids)
     shown = shown_values(doc, asset_id, time, cids)
-    if _kind(doc, asset_id) == _c3d().ASSET_KIND:
-        keys = {cid: _c3d().new_key(cid, time, shown[cid]) for cid in cids}
+    if _kind(doc, asset_id) == c3d.ASSET_KIND:
+        keys = {cid: c3d.new_key(cid, time, shown[cid]) for cid in cids}
     else:
         keys = {cid: Key(float(time), shown[cid]) for cid in cids}
     return SetKeys(doc, keys, text=text)
@@ -398,8 +254,7 @@ def copy_pose(doc: Document, asset_id: str, joint: str, time: float) -> PoseClip
     rotations only, never the position."""
     kind = _kind(doc, asset_id)
     values: dict[str, dict[str, float]] = {}
-    if kind == _c2d().ASSET_KIND:
-        c2d = _c2d()
+    if kind == c2d.ASSET_KIND:
         ch = c2d.character(doc, asset_id)
         names = [joint] if joint else [j.name for j in ch.joints if not j.is_dynamic]
         for name in names:
@@ -408,7 +263,6 @@ def copy_pose(doc: Document, asset_id: str, joint: str, time: float) -> PoseClip
         for name in names:
             values[name] = {"angle": shown[c2d.angle_channel_id(asset_id, name)]}
     else:
-        c3d = _c3d()
         # Euler angles whatever the joint is keyed in (a quaternion joint's are converted).
         posed = c3d.pose_skeleton(doc, asset_id, time)
         keys = posed.joint_keys()
@@ -419,7 +273,7 @@ def copy_pose(doc: Document, asset_id: str, joint: str, time: float) -> PoseClip
     return PoseClip(kind, asset_id, values)
 
 
-def mirror_negates_2d(character: Any) -> bool:
+def mirror_negates_2d(character: Character) -> bool:
     """Whether mirroring a 2D character's pose negates its angles.
 
     A pose mirrors about the character's own left/right plane. Seen from the front (the
@@ -438,7 +292,7 @@ def mirror_negates_2d(character: Any) -> bool:
     return any(abs(float(a.pivot[0] - b.pivot[0])) > 0.02 * max(width, 1e-9) for a, b in pairs)
 
 
-def lateral_axis_3d(skeleton: Any) -> int:
+def lateral_axis_3d(skeleton: Skeleton) -> int:
     """The skeleton's left-right axis (0 = x, 1 = y, 2 = z): where the rest offsets of its
     left/right joint pairs differ most (x when it has no pairs)."""
     names = [j.name for j in skeleton.joints]
@@ -462,7 +316,7 @@ def mirrored_value(kind: str, dof: str, value: float, negate_2d: bool = True, la
     rotation order, for joints whose rest frames are aligned with the skeleton's axes
     (CSE 169, MIT, BVH offsets).
     """
-    if kind == _c2d().ASSET_KIND:
+    if kind == c2d.ASSET_KIND:
         return -value if negate_2d else value
     axis = "xyz".index(dof[-1])
     return value if axis == lateral else -value
@@ -496,8 +350,7 @@ def paste_values(doc: Document, clip: PoseClip, asset_id: str, mirrored: bool = 
     if kind != clip.kind:
         return {}
     out: dict[str, float] = {}
-    if kind == _c2d().ASSET_KIND:
-        c2d = _c2d()
+    if kind == c2d.ASSET_KIND:
         ch = c2d.character(doc, asset_id)
         names = {j.name for j in ch.joints}
         negate = mirror_negates_2d(ch)
@@ -510,7 +363,6 @@ def paste_values(doc: Document, clip: PoseClip, asset_id: str, mirrored: bool = 
                 mirrored_value(kind, "angle", value, negate_2d=negate) if mirrored else value)
         # Clamped to the target joints' limits (a pendulum's local angle at ``time``).
         return c2d.clamp_values(doc, out, 0.0 if time is None else time)
-    c3d = _c3d()
     runtime = c3d.character(doc, asset_id)
     keys = list(runtime.joint_keys)
     source_keys = keys
@@ -542,8 +394,8 @@ def paste_pose_command(doc: Document, clip: PoseClip, asset_id: str, time: float
     values = paste_values(doc, clip, asset_id, mirrored, time)
     if not values:
         return None
-    if _kind(doc, asset_id) == _c3d().ASSET_KIND:
-        keys = {cid: _c3d().new_key(cid, time, v) for cid, v in values.items()}
+    if _kind(doc, asset_id) == c3d.ASSET_KIND:
+        keys = {cid: c3d.new_key(cid, time, v) for cid, v in values.items()}
     else:
         keys = {cid: Key(float(time), v) for cid, v in values.items()}
     return SetKeys(doc, keys, text="Paste Pose Mirrored" if mirrored else "Paste Pose")
@@ -553,7 +405,7 @@ def is_character(doc: Document, asset_id: str) -> bool:
     asset = doc.assets.get(asset_id)
     if asset is None or asset_id not in doc.runtime:
         return False
-    return asset.kind in (_c2d().ASSET_KIND, _c3d().ASSET_KIND)
+    return asset.kind in (c2d.ASSET_KIND, c3d.ASSET_KIND)
 
 
 __all__ = [

@@ -239,15 +239,6 @@ def progress(doc: Document) -> tuple[int, bool]:
     return revision, busy
 
 
-def ensure_caches(doc: Document) -> None:
-    """Create ``doc``'s simulation caches now. An editor context calls it before it
-    subscribes to the document, so that the caches drop what a change invalidates before any
-    view hears of the change (listeners are told in the order they subscribed)."""
-    from qtanimator.document.character2d import simulation
-
-    simulation(doc)
-
-
 def stop_simulations(doc: Document) -> None:
     """Stop the worker threads of ``doc``'s caches (they start again when asked)."""
     for cache in list(doc.caches.values()):

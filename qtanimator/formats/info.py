@@ -17,7 +17,7 @@ Summariser = Callable[[Path], dict[str, Any]]
 #: suffix -> (module, function name); imported only when needed.
 SUMMARISERS: dict[str, tuple[str, str]] = {
     ".qtanim": ("qtanimator.formats.info", "summarize_project"),
-    ".json": ("qtanimator.formats.info", "summarize_project"),
+    ".json": ("qtanimator.formats.info", "summarize_json"),
     ".anim": ("qtanimator.formats.anim", "summarize"),
     ".svg": ("qtanimator.formats.svg_rig", "summarize"),
     ".skel": ("qtanimator.formats.skel", "summarize"),
@@ -53,6 +53,16 @@ def channel_summary(channels: dict[str, Any]) -> dict[str, Any]:
         "keys": keys,
         "key_time_range": [min(times), max(times)] if times else None,
     }
+
+
+def summarize_json(path: Path) -> dict[str, Any]:
+    """A ``.json`` file: a Spine skeleton when it looks like one, else a project."""
+    from qtanimator.formats.spine import looks_like_spine
+    from qtanimator.formats.spine import summarize as summarize_spine
+
+    if looks_like_spine(path):
+        return summarize_spine(path)
+    return summarize_project(path)
 
 
 def summarize_project(path: Path) -> dict[str, Any]:

@@ -13,12 +13,14 @@ import argparse
 import os
 import sys
 from collections.abc import Iterator, Sequence
-from pathlib import Path
 from typing import Any, NoReturn
 
-import numpy as np
-
+from qtanimator.document.parameters import RENDER
 from qtanimator.formats.errors import FormatError
+from qtanimator.render import parallel
+from qtanimator.render.headless import ensure_gui_app, frames_2d, load_scene, options_3d
+
+__all__ = ["choose_view", "frames_2d", "load_scene", "options_3d", "render_main"]
 
 
 class _OneLineParser(argparse.ArgumentParser):
@@ -39,7 +41,8 @@ def _parser() -> argparse.ArgumentParser:
                         "clips drop frames evenly, keeping the duration) or a video (.mp4, .mov, .mkv, .webm, .avi)")
     p.add_argument("--frames", help="frame range A:B (inclusive); the project's range by default")
     p.add_argument("--fps", type=float, help="frames per second (the project's by default)")
-    p.add_argument("--size", default="960x640", help="image size WxH (default 960x640)")
+    size = f"{RENDER['render.width'].default}x{RENDER['render.height'].default}"  # the Export dialog's too
+    p.add_argument("--size", default=size, help=f"image size WxH (default {size})")
     p.add_argument("--background",
                    help="a colour name or #rrggbb, or 'transparent' (default: white in 2D, the viewport's "
                         "grey in 3D)")
@@ -80,44 +83,6 @@ def _parse_frames(text: str | None, default: tuple[int, int]) -> tuple[int, int]
     return first, last
 
 
-def load_scene(path: str | os.PathLike[str]) -> Any:
-    """A document for any file the program opens: a project, an SVG character / folder, or a
-    3D file (``.skel``, ``.bvh``, ``.glb`` …, imported into a new document)."""
-    from qtanimator.document import Document, open_document
-
-    p = Path(path)
-    if not p.exists():
-        raise FormatError("no such file or folder.", p)
-    if p.is_file() and p.suffix.lower() in (".qtanim", ".json"):
-        return open_document(p)
-    if p.is_dir() or p.suffix.lower() == ".svg":
-        from qtanimator.document.character2d import add_characters_command
-
-        doc = Document()
-        add_characters_command(doc, p, new_project_range=True).do(doc)  # 0…300, as opening it in the GUI
-        doc.path = None
-        return doc
-    from qtanimator.document.import3d import SUFFIXES, import_file
-
-    if p.is_file() and p.suffix.lower() in SUFFIXES:
-        # as File ▸ Open does: a new document with the file imported (its clip's frame range and fps)
-        doc = Document()
-        import_file(doc, p).command.do(doc)
-        doc.path = None
-        return doc
-    raise FormatError(f"qtanimator reads projects (.qtanim), SVG characters and 3D files "
-                      f"({', '.join(SUFFIXES)}), not '{p.suffix}' files.", p)
-
-
-def _ensure_gui_app() -> Any:
-    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
-        if not os.environ.get("QT_QPA_PLATFORM"):
-            os.environ["QT_QPA_PLATFORM"] = "offscreen"
-    from PySide6.QtGui import QGuiApplication
-
-    return QGuiApplication.instance() or QGuiApplication(["qtanimator-render"])
-
-
 class _Progress:
     """The render's progress bar: a tqdm bar on stderr when stderr is a terminal; nothing
     when it is not (a log file or a pipe gets no ``\\r`` lines, only the final summary)."""
@@ -147,34 +112,9 @@ class _Progress:
             self._bar = None
 
 
-def frames_2d(doc: Any, times: Sequence[float], size: tuple[int, int], background: str) -> Iterator[np.ndarray]:
-    """RGBA frames of the 2D characters at ``times`` with a steady camera."""
-    from qtanimator.render.painter2d import animation_bounds, image_to_array, render_frame
-
-    view = animation_bounds(doc, times)
-    for t in times:
-        yield image_to_array(render_frame(doc, t, size, background, view=view))
-
-
-def options_3d(background: str | None) -> Any:
-    """The 3D view options of a render: no skeleton, no light markers, ``background`` (a colour
-    name, #rrggbb or 'transparent'; None: the viewport's)."""
-    from qtanimator.render.gl.renderer import ViewOptions
-    from qtanimator.render.painter2d import background_color
-
-    options = ViewOptions(show_skeleton=False, show_lights=False)
-    if background is not None:
-        c = background_color(background)  # ValueError for a bad colour
-        options.background = (c.redF(), c.greenF(), c.blueF(), c.alphaF())
-        if c.alpha() == 0:
-            options.show_grid = False  # a transparent render is for compositing: no floor grid
-    return options
-
-
 def _frames_any(ns: argparse.Namespace, doc: Any, times: Sequence[float], size: tuple[int, int]) -> Iterator[Any]:
     """The frames of ``ns.view`` in this process, in ``--jobs`` processes or on a ``--dask``
     cluster (the same frames, byte for byte)."""
-    from qtanimator.render import parallel
     from qtanimator.render.export import output_kind
 
     if ns.jobs is not None and ns.jobs < 1:
@@ -264,7 +204,9 @@ def _render_main(argv: Sequence[str]) -> int:
         if ns.fps is not None:
             if not ns.fps > 0:
                 raise ValueError("--fps must be positive")
-            doc.parameters["fps"] = float(ns.fps)
+            from qtanimator.document.commands import SetParameter
+
+            SetParameter(doc, "fps", float(ns.fps)).do(doc)  # the frame numbers stay (not set_fps_command)
         first, last = _parse_frames(ns.frames, doc.frame_range)
         fps = doc.fps
         times = [f / fps for f in range(first, last + 1)]
@@ -283,7 +225,7 @@ def _render_main(argv: Sequence[str]) -> int:
             # the 3D renderer knows how to get a GL-capable platform (a private Xvfb headless)
             render3d.ensure_gui_application()
         else:
-            _ensure_gui_app()
+            ensure_gui_app()
         from qtanimator.render.painter2d import background_color
 
         if ns.background is not None:

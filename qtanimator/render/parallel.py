@@ -84,8 +84,8 @@ def bake_3d(doc: Any, times: Sequence[float],
     them) and every visible cloth simulated over ``times`` in this process:
     ``(camera, options, {cloth id: [(cache slot, positions) at each time]})``."""
     from qtanimator.document import cloth
-    from qtanimator.render.cli_render import options_3d
     from qtanimator.render.gl.renderer import grid_scale_for
+    from qtanimator.render.headless import options_3d
     from qtanimator.render.render3d import default_camera
     from qtanimator.render.scene3d import scene_bounds, scene_items
 
@@ -130,10 +130,11 @@ def _worker_document(scene: str, fps: float) -> Any:
     cached = getattr(_LOCAL, "doc", None)
     if cached is not None and cached[0] == key:
         return cached[1]
-    from qtanimator.render.cli_render import load_scene
+    from qtanimator.document.commands import SetParameter
+    from qtanimator.render.headless import load_scene
 
     doc = load_scene(scene)
-    doc.parameters["fps"] = fps
+    SetParameter(doc, "fps", fps).do(doc)
     _LOCAL.doc = (key, doc)
     return doc
 
@@ -150,9 +151,9 @@ def render_chunk(spec: ChunkSpec | Chunk3D) -> list[Any]:
     """RGBA frames of one chunk, or PNG-encoded ones (``spec.encode``); runs in a worker."""
     if isinstance(spec, Chunk3D):
         return _render_chunk_3d(spec)
-    from qtanimator.render.cli_render import _ensure_gui_app
+    from qtanimator.render.headless import ensure_gui_app
 
-    _ensure_gui_app()
+    ensure_gui_app()
     from PySide6.QtCore import QRectF
 
     from qtanimator.document.character2d import simulation

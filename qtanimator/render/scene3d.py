@@ -160,7 +160,7 @@ def gpu_texcoords(skin: Any, runtime: Any) -> np.ndarray | None:
     extras = getattr(skin, "extras", None)
     cached = extras.get("_gpu_texcoords") if isinstance(extras, dict) else None
     if cached is not None:
-        return cached  # type: ignore[no-any-return]
+        return cached
     uv = getattr(skin, "texcoords", None)
     if uv is None or np.shape(uv)[1] < 2:
         return None
@@ -214,7 +214,7 @@ def gpu_skin_arrays(skin: Any) -> dict[str, Any]:
     extras = getattr(skin, "extras", None)
     cached = extras.get("_gpu_arrays") if isinstance(extras, dict) else None
     if cached is not None:
-        return cached  # type: ignore[no-any-return]
+        return cached
     positions = np.asarray(skin.positions, dtype=float)
     normals = skin.normals
     normals = None if normals is None or len(normals) != len(positions) else np.asarray(normals, dtype=float)

@@ -8,9 +8,9 @@ them (``Viewport3D.cameraChanged``), and editing one moves the camera at once
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any
+from typing import Any, Protocol
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import Qt, SignalInstance
 from PySide6.QtWidgets import (
     QAbstractSpinBox,
     QDialog,
@@ -21,8 +21,21 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-if TYPE_CHECKING:
-    from qtanimator.ui.viewport import Viewport3D
+from qtanimator.render.gl.camera import OrbitCamera
+
+
+class CameraView(Protocol):
+    """What the fields need of a view (the 3D view, :mod:`qtanimator.ui.viewport`, is one):
+    its orbit camera, a signal when that moves, and a way to place it by numbers."""
+
+    @property
+    def camera(self) -> OrbitCamera: ...
+
+    @property
+    def cameraChanged(self) -> SignalInstance: ...
+
+    def set_camera(self, distance: float | None = None, azimuth: float | None = None,
+                   inclination: float | None = None) -> None: ...
 
 
 def _box(parent: QWidget, name: str, lo: float, hi: float, decimals: int, suffix: str = "") -> QDoubleSpinBox:
@@ -36,9 +49,9 @@ def _box(parent: QWidget, name: str, lo: float, hi: float, decimals: int, suffix
 
 
 class CameraFields(QWidget):
-    """Distance, azimuth and inclination (degrees) of a :class:`Viewport3D`'s orbit camera."""
+    """Distance, azimuth and inclination (degrees) of a view's orbit camera (the 3D view's)."""
 
-    def __init__(self, view: Viewport3D, parent: QWidget | None = None) -> None:
+    def __init__(self, view: CameraView, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("cameraFields")
         self.view = view
@@ -87,7 +100,7 @@ class CameraFields(QWidget):
 class CameraDialog(QDialog):
     """A small tool window holding :class:`CameraFields` (it stays open while you orbit)."""
 
-    def __init__(self, view: Viewport3D, parent: QWidget | None = None) -> None:
+    def __init__(self, view: CameraView, parent: QWidget | None = None) -> None:
         super().__init__(parent)
         self.setObjectName("cameraDialog")
         self.setWindowTitle("3D Camera")
@@ -100,7 +113,7 @@ class CameraDialog(QDialog):
         layout.addWidget(buttons)
 
 
-def show_camera_dialog(window: Any, view: Viewport3D) -> CameraDialog:
+def show_camera_dialog(window: Any, view: CameraView) -> CameraDialog:
     """View ▸ 3D Camera…: show (or raise) the window's camera dialog."""
     dialog = getattr(window, "camera_dialog", None)
     if not isinstance(dialog, CameraDialog) or dialog.fields.view is not view:
@@ -113,4 +126,4 @@ def show_camera_dialog(window: Any, view: Viewport3D) -> CameraDialog:
     return dialog
 
 
-__all__ = ["CameraDialog", "CameraFields", "show_camera_dialog"]
+__all__ = ["CameraDialog", "CameraFields", "CameraView", "show_camera_dialog"]

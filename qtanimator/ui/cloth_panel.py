@@ -28,41 +28,30 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from qtanimator.core.cloth import INTEGRATORS, PIN_MODES, ClothParams, Sphere
+from qtanimator.core.cloth import ClothParams, Sphere
 from qtanimator.document.cloth import ASSET_KIND, add_cloth_command, cloth_params, set_cloth_param_command
 from qtanimator.document.document import DocumentChange
+from qtanimator.document.parameters import CLOTH, CLOTH_SPHERE_CENTRE, CLOTH_SPHERE_RADIUS, CLOTH_WIND_SPEED, Param
 from qtanimator.ui.context import EditorContext
-from qtanimator.ui.widgets import CheckedDoubleSpinBox, CheckedSpinBox
+from qtanimator.ui.param_fields import ParamDoubleSpinBox, ParamSpinBox, editor_for, spin_for
 
 _gestures = itertools.count(1)
 
-#: (minimum, maximum, step, decimals) of the float fields. The minimums are the ones
-#: :meth:`ClothParams.validate` enforces (≥ 0, or > 0 for sizes and mass); where the model
-#: has no maximum the field's is far beyond any useful value, so a typed value is accepted
-#: rather than clamped (stiffness 1e7 is fine: the implicit integrator takes it). A typed
-#: value outside a field's range is refused with the reason shown, never clamped.
+# Every field's range, step, decimals, choices, special minimum text and the reasons shown
+# when a typed value beyond a limit is refused come from the parameter schema
+# (qtanimator.document.parameters.CLOTH, built from ClothParams' fields). The minimums are
+# the ones ClothParams.validate enforces; where the model has no maximum the field's is far
+# beyond any useful value (stiffness 1e7 is fine: the implicit integrator takes it). A typed
+# value outside a field's range is refused with the reason shown, never clamped.
+#: (minimum, maximum, step, decimals) of the float fields: a view of the schema.
 FLOAT_RANGES: dict[str, tuple[float, float, float, int]] = {
-    "width": (0.001, 1e4, 0.1, 3), "height": (0.001, 1e4, 0.1, 3),
-    "total_mass": (0.001, 1e6, 0.1, 3),
-    "structural_stiffness": (0.0, 1e9, 10.0, 2), "structural_damping": (0.0, 1e6, 0.05, 3),
-    "shear_stiffness": (0.0, 1e9, 10.0, 2), "shear_damping": (0.0, 1e6, 0.05, 3),
-    "bend_stiffness": (0.0, 1e9, 1.0, 2), "bend_damping": (0.0, 1e6, 0.01, 3),
-    "drag_coefficient": (0.0, 1e3, 0.05, 3), "air_density": (0.0, 1e5, 0.05, 3),
-    "turbulence": (0.0, 1e4, 0.1, 3), "gravity": (-1e4, 1e4, 0.1, 3),
-    "ground_height": (-1e6, 1e6, 0.05, 3), "ground_restitution": (0.0, 1.0, 0.05, 3),
-    "ground_friction": (0.0, 100.0, 0.05, 3), "collision_margin": (0.0, 100.0, 0.001, 4),
-}
-#: Why a field stops where the model does not (shown when a value beyond it is typed).
-RANGE_REASONS: dict[str, str] = {
-    "ground_restitution": "above 1 every bounce would gain energy",
-    "rows": "a bigger grid would take too long to simulate", "cols": "a bigger grid would take too long to simulate",
-}
-INT_RANGES: dict[str, tuple[int, int]] = {"rows": (2, 1000), "cols": (2, 1000), "turbulence_seed": (0, 2**31 - 1),
-                                          "substeps": (0, 100_000)}
-#: What an int field shows at its minimum when that value means something else.
-SPECIAL_MINIMUM: dict[str, str] = {"substeps": "auto"}
-CHOICES: dict[str, tuple[str, ...]] = {"pin_mode": PIN_MODES, "integrator": INTEGRATORS}
-VECTORS = ("wind", "origin", "orientation")
+    k: (float(p.minimum or 0.0), float(p.maximum or 0.0), float(p.step or 0.0), int(p.decimals or 0))
+    for k, p in CLOTH.items() if p.kind == "float"}
+#: (minimum, maximum) of the int fields: a view of the schema.
+INT_RANGES: dict[str, tuple[int, int]] = {k: (int(p.minimum or 0), int(p.maximum or 0))
+                                          for k, p in CLOTH.items() if p.kind == "int"}
+CHOICES: dict[str, tuple[str, ...]] = {k: p.choices for k, p in CLOTH.items() if p.kind == "choice"}
+VECTORS = tuple(k for k, p in CLOTH.items() if p.kind == "vector")
 GROUPS = (
     ("Grid", ("rows", "cols", "width", "height", "total_mass", "origin", "orientation")),
     ("Springs", ("structural_stiffness", "structural_damping", "shear_stiffness", "shear_damping",
@@ -75,7 +64,8 @@ GROUPS = (
 
 
 def _label(name: str) -> str:
-    return name.replace("_", " ").capitalize()
+    """The row label of a cloth field: the schema's label with its unit."""
+    return CLOTH[name].title
 
 
 class ClothPanel(QWidget):
@@ -181,17 +171,13 @@ class ClothPanel(QWidget):
         self.live.blockSignals(False)
 
     # ------------------------------------------------------------- editors
-    def _spin(self, name: str, parent: QWidget, lo: float, hi: float, step: float,
-              decimals: int) -> CheckedDoubleSpinBox:
-        s = CheckedDoubleSpinBox(parent, label=_label(name))
-        s.setRange(lo, hi)
-        s.setSingleStep(step)
-        s.setDecimals(decimals)
-        s.setObjectName(f"cloth_{name}")
-        s.why_max = RANGE_REASONS.get(name, "")
+    def _spin(self, param: Param, name: str, parent: QWidget,
+              label: str = "") -> ParamSpinBox | ParamDoubleSpinBox:
+        """The spin box of ``param`` (range, step, decimals, reasons from the schema), named
+        ``cloth_<name>``."""
+        s = spin_for(param, parent, f"cloth_{name}", label or param.label)
         # A typed value is one edit, committed with Enter or on leaving the field (not one
         # command and one re-simulation per keystroke); the arrows still apply at once.
-        s.setKeyboardTracking(False)
         s.editingFinished.connect(self.end_gesture)
         s.refused.connect(self._refused)
         return s
@@ -201,51 +187,43 @@ class ClothPanel(QWidget):
         self.message.setText(reason)
 
     def _make_editor(self, name: str, parent: QWidget) -> QWidget:
-        if name in FLOAT_RANGES:
-            s = self._spin(name, parent, *FLOAT_RANGES[name])
+        param = CLOTH[name]
+        if param.kind == "float":
+            s = self._spin(param, name, parent)
             s.valueChanged.connect(lambda v, n=name: self.edit(n, float(v)))
             self.editors[name] = s
             return s
-        if name in INT_RANGES:
-            i = CheckedSpinBox(parent, label=_label(name))
-            i.refused.connect(self._refused)
-            i.why_max = RANGE_REASONS.get(name, "")
-            i.setObjectName(f"cloth_{name}")
-            i.setRange(*INT_RANGES[name])
-            if name in SPECIAL_MINIMUM:
-                i.setSpecialValueText(SPECIAL_MINIMUM[name])
-            i.setKeyboardTracking(False)
-            i.editingFinished.connect(self.end_gesture)
+        if param.kind == "int":
+            i = self._spin(param, name, parent)
             i.valueChanged.connect(lambda v, n=name: self.edit(n, int(v)))
             self.editors[name] = i
             return i
-        if name in CHOICES:
-            c = QComboBox(parent)
-            c.setObjectName(f"cloth_{name}")
-            c.addItems(list(CHOICES[name]))
+        if param.kind == "choice":
+            c = editor_for(param, parent, f"cloth_{name}")
+            assert isinstance(c, QComboBox)
             c.currentTextChanged.connect(lambda v, n=name: self.edit(n, str(v)))
             self.editors[name] = c
             return c
-        if name == "ground_enabled":
-            b = QCheckBox(parent)
-            b.setObjectName("cloth_ground_enabled")
-            b.toggled.connect(lambda v: self.edit("ground_enabled", bool(v)))
+        if param.kind == "bool":
+            b = editor_for(param, parent, f"cloth_{name}")
+            assert isinstance(b, QCheckBox)
+            b.toggled.connect(lambda v, n=name: self.edit(n, bool(v)))
             self.editors[name] = b
             return b
-        if name in VECTORS:
+        if param.kind == "vector":
             w = QWidget(parent)
             row = QHBoxLayout(w)
             row.setContentsMargins(0, 0, 0, 0)
             spins = []
-            lim = 1e6 if name != "orientation" else 2 * math.pi
             for axis in "xyz":
-                s = self._spin(f"{name}_{axis}", w, -lim, lim, 0.1, 3)
+                s = self._spin(param, f"{name}_{axis}", w, f"{param.label} {axis}")
                 s.valueChanged.connect(lambda _v, n=name: self._vector_edited(n))
                 row.addWidget(s)
                 spins.append(s)
             self.editors[name] = spins
             if name == "wind":
-                speed = self._spin("wind_speed", w, 0.0, 1e6, 0.5, 2)
+                speed = self._spin(CLOTH_WIND_SPEED, "wind_speed", w)
+                assert isinstance(speed, ParamDoubleSpinBox)
                 speed.setPrefix("speed ")
                 speed.valueChanged.connect(self._speed_edited)
                 row.addWidget(speed)
@@ -257,8 +235,9 @@ class ClothPanel(QWidget):
             row.setContentsMargins(0, 0, 0, 0)
             on = QCheckBox("on", w)
             on.setObjectName("cloth_sphere_on")
-            spins = [self._spin(f"sphere_{k}", w, -1e6, 1e6, 0.05, 3) for k in ("x", "y", "z", "radius")]
-            spins[3].setRange(0.001, 1e6)
+            spins = [self._spin(CLOTH_SPHERE_CENTRE, f"sphere_{k}", w, f"{CLOTH_SPHERE_CENTRE.label} {k}")
+                     for k in ("x", "y", "z")]
+            spins.append(self._spin(CLOTH_SPHERE_RADIUS, "sphere_radius", w))
             on.toggled.connect(lambda _v: self._sphere_edited())
             row.addWidget(on)
             for s in spins:
@@ -369,6 +348,8 @@ class ClothPanel(QWidget):
     def refresh_fields(self) -> None:
         asset = self.current_asset()
         enabled = bool(asset)
+        # No cloth in the project: the fields are disabled and show what a new cloth gets.
+        # A cloth whose stored parameters are bad raises here (cloth_params), no defaults.
         params = cloth_params(self.ctx.doc, asset) if asset else ClothParams()
         self._updating = True
         try:

@@ -18,12 +18,14 @@ import sys
 from PySide6.QtCore import QAbstractEventDispatcher, QCoreApplication, QElapsedTimer, QEvent, QObject, QTimer, Signal
 from PySide6.QtGui import QUndoStack
 
+from qtanimator.core.rig2d import Character
+from qtanimator.document.character2d import ensure_caches
+from qtanimator.document.character3d import Character3D
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, DocumentChange
 from qtanimator.document.gesture import Gesture
 from qtanimator.document.pose import clear_pending
 from qtanimator.document.simulation import (
-    ensure_caches,
     pause_workers,
     resume_workers,
     stop_simulations,
@@ -55,7 +57,7 @@ def gate_workers_on_idle() -> bool:
     no application or dispatcher yet."""
     app = QCoreApplication.instance()
     dispatcher = QAbstractEventDispatcher.instance(app.thread()) if app is not None else None
-    if dispatcher is None:
+    if app is None or dispatcher is None:
         return False
     if not dispatcher.property("qtanimatorWorkerGate"):
         # When a worker does run beside a busy UI thread (it waited its longest), hand the
@@ -154,13 +156,11 @@ class EditorContext(QObject):
             return
         if joint:
             runtime = self.doc.runtime.get(asset)
-            keys = getattr(runtime, "joint_keys", None)   # 3D: a property (a list)
-            if callable(keys):
-                keys = keys()
-            if isinstance(keys, list):
-                names = set(keys)
-            elif isinstance(getattr(runtime, "joints", None), list):
-                names = {getattr(j, "name", None) for j in runtime.joints}
+            names: set[str]
+            if isinstance(runtime, Character3D):
+                names = set(runtime.joint_keys)
+            elif isinstance(runtime, Character):
+                names = {j.name for j in runtime.joints}
             else:
                 return  # not loaded (or unknown): nothing to check against
             if joint not in names:

@@ -4,7 +4,8 @@
 channel tree (asset → joint → DOF, visibility check boxes, filter) beside a toolbar, the
 plot (``curvePlot``) and numeric fields for the active key. The parts live in
 :mod:`qtanimator.ui.curves`; gestures and shortcuts are described in
-:mod:`qtanimator.ui.curves.view`.
+:mod:`qtanimator.ui.curves.view`, and what a drag does (without Qt) in
+:mod:`qtanimator.ui.curves.drags`.
 
 Ctrl+C / Ctrl+V / Ctrl+Shift+V (while the editor has the focus) copy the selected keys and
 paste them at the current frame (merging, or replacing the pasted range), on the one key
@@ -18,6 +19,7 @@ Selection is shared through the editor context: selecting rows calls
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import replace
 from typing import Any
 
@@ -316,7 +318,8 @@ class CurveEditor(QWidget):
         """Tangent rule for the selected keys on the in side, the out side, or both."""
         sel = self.view.selected_keys()
         if sel:
-            self.ctx.push(SetTangents(self.ctx.doc, sel, rule, side))
+            keys: dict[str, Iterable[int]] = dict(sel)  # SetTangents takes any iterable of indices
+            self.ctx.push(SetTangents(self.ctx.doc, keys, rule, side))
 
     def set_broken(self, broken: bool) -> None:
         sel = self.view.selected_keys()

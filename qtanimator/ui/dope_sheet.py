@@ -643,7 +643,7 @@ class DopeSheetView(QWidget):
         # Keys.
         for i in range(first, last):
             r = self.rows[i]
-            y = self.row_y(i) + ROW_HEIGHT / 2.0
+            centre_y = self.row_y(i) + ROW_HEIGHT / 2.0
             frames = self.row_frames(r)
             a, b = np.searchsorted(frames, [f_lo, f_hi])
             if a >= b:
@@ -656,7 +656,7 @@ class DopeSheetView(QWidget):
             for pick, symbol in ((~mask, kind), (mask, kind + "_selected")):
                 if pick.any():
                     xs_ = np.unique(px[pick])
-                    draw_symbols(p, _diamond(symbol), xs_, np.full(len(xs_), y))
+                    draw_symbols(p, _diamond(symbol), xs_, np.full(len(xs_), centre_y))
         # Names.
         p.fillRect(QRect(0, top, NAME_WIDTH, bottom - top), NAME_BACKGROUND)
         for i in range(first, last):

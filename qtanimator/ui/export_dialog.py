@@ -40,6 +40,8 @@ from PySide6.QtWidgets import (
 )
 
 from qtanimator.document.document import Document
+from qtanimator.document.parameters import RENDER
+from qtanimator.ui.param_fields import spin_for
 
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
@@ -57,8 +59,10 @@ VIEWS = {
     "gltf": "glTF file (.glb)",
 }
 
-#: The reference program's export background (0.6, 0.6, 0.95) (2D; 3D keeps the viewport's).
-DEFAULT_BACKGROUND = QColor(153, 153, 242)
+#: The reference program's export background (0.6, 0.6, 0.95) (2D; 3D keeps the viewport's):
+#: the schema's ``render.background``.
+DEFAULT_BACKGROUND = QColor.fromRgbF(*(float(c) for c in RENDER["render.background"].default))
+assert set(FORMATS) == set(RENDER["render.format"].choices) and set(VIEWS) == set(RENDER["render.view"].choices)
 
 
 @dataclass
@@ -66,15 +70,15 @@ class ExportSettings:
     """What to export: ``out`` is a folder or ``…%04d.png`` pattern for PNG, else a file."""
 
     out: str
-    fmt: str = "png"
-    width: int = 960
-    height: int = 640
-    fps: float = 60.0
-    first: int = 0
-    last: int = 240
+    fmt: str = RENDER["render.format"].default
+    width: int = RENDER["render.width"].default
+    height: int = RENDER["render.height"].default
+    fps: float = RENDER["render.fps"].default
+    first: int = RENDER["render.first"].default
+    last: int = RENDER["render.last"].default
     background: QColor | None = None
     #: "2d", "3d" or "gltf" (see :data:`VIEWS`)
-    view: str = "2d"
+    view: str = RENDER["render.view"].default
     #: the 3D view's camera (an OrbitCamera; None: framed as ``qtanimator render`` does)
     camera: Any = None
 
@@ -207,19 +211,20 @@ class ExportDialog(QDialog):
         row.addWidget(self.path_edit, 1)
         row.addWidget(browse)
         form.addRow("Output", row)
-        self.width_box = _spin(self, "exportWidth", 16, 8192, s.width)
-        self.height_box = _spin(self, "exportHeight", 16, 8192, s.height)
+        self.width_box = _spin(self, "exportWidth", "render.width", s.width)
+        self.height_box = _spin(self, "exportHeight", "render.height", s.height)
         size_row = QHBoxLayout()
         size_row.addWidget(self.width_box)
         size_row.addWidget(self.height_box)
         form.addRow("Size", size_row)
-        self.fps_box = QDoubleSpinBox(self)
-        self.fps_box.setObjectName("exportFps")
-        self.fps_box.setRange(1.0, 240.0)
-        self.fps_box.setValue(s.fps)
+        fps_box = spin_for(RENDER["render.fps"], self, "exportFps")
+        assert isinstance(fps_box, QDoubleSpinBox)
+        fps_box.setKeyboardTracking(True)  # the GIF note follows the typing
+        fps_box.setValue(s.fps)
+        self.fps_box = fps_box
         form.addRow("Frame rate", self.fps_box)
-        self.first_box = _spin(self, "exportFirst", -100000, 100000, s.first)
-        self.last_box = _spin(self, "exportLast", -100000, 100000, s.last)
+        self.first_box = _spin(self, "exportFirst", "render.first", s.first)
+        self.last_box = _spin(self, "exportLast", "render.last", s.last)
         range_row = QHBoxLayout()
         range_row.addWidget(self.first_box)
         range_row.addWidget(self.last_box)
@@ -293,10 +298,11 @@ class ExportDialog(QDialog):
                               view=str(self.view_box.currentData()))
 
 
-def _spin(parent: QWidget, name: str, lo: int, hi: int, value: int) -> QSpinBox:
-    box = QSpinBox(parent)
-    box.setObjectName(name)
-    box.setRange(lo, hi)
+def _spin(parent: QWidget, name: str, path: str, value: int) -> QSpinBox:
+    """The field of the render setting ``path`` (range and label from the schema)."""
+    box = spin_for(RENDER[path], parent, name)
+    assert isinstance(box, QSpinBox)
+    box.setKeyboardTracking(True)
     box.setValue(value)
     return box
 

@@ -15,11 +15,9 @@ from itself is refused with a message in the status bar.
 
 from __future__ import annotations
 
-import importlib
 import math
 from collections.abc import Callable, Collection
 from dataclasses import dataclass
-from types import ModuleType
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -58,7 +56,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from qtanimator.document import outliner
+from qtanimator.document import character2d, character3d, outliner
 from qtanimator.document.commands import Command, Macro, RemoveAsset
 from qtanimator.document.document import Document, DocumentChange, split_channel_id
 from qtanimator.document.gesture import Gesture
@@ -79,24 +77,6 @@ LIGHT_PREFIX = "light:"
 LIGHT_TITLES = {"light1": "Light 1 (key)", "light2": "Light 2 (fill)"}
 SLIDER_STEPS_PER_UNIT = 10  # 0.1° (or 0.1 unit) per slider step
 TRANSLATION_LIMIT = 5000.0
-
-
-def optional_module(name: str) -> ModuleType | None:
-    """An engine module, or None while it does not exist yet."""
-    try:
-        return importlib.import_module(name)
-    except ModuleNotFoundError as exc:
-        if exc.name is not None and name.startswith(exc.name):
-            return None
-        raise
-
-
-def c2d() -> ModuleType | None:
-    return optional_module("qtanimator.document.character2d")
-
-
-def c3d() -> ModuleType | None:
-    return optional_module("qtanimator.document.character3d")
 
 
 # ------------------------------------------------------------------------ DOFs
@@ -145,57 +125,56 @@ def dof_specs(doc: Document, asset: str, joint: str, time: float) -> list[DofSpe
     its position."""
     kind = _asset_kind(doc, asset)
     runtime = doc.runtime.get(asset)
-    m2, m3 = c2d(), c3d()
-    if m2 is not None and kind == m2.ASSET_KIND and runtime is not None:
-        pose = m2.evaluate_pose(doc, asset, time, block=False)  # a view: never simulates
+    if kind == character2d.ASSET_KIND and runtime is not None:
+        pose = character2d.evaluate_pose(doc, asset, time, block=False)  # a view: never simulates
         if joint == "":
             tx, ty = (float(v) for v in pose.translation)
 
             def move(axis: int) -> Callable[[float, float, object], Command]:
                 def make(value: float, t: float, gesture: object) -> Command:
-                    cur = m2.translation(doc, asset, t)
+                    cur = character2d.translation(doc, asset, t)
                     xy = (value, float(cur[1])) if axis == 0 else (float(cur[0]), value)
-                    return m2.move_character(doc, asset, xy, t, gesture=gesture)
+                    return character2d.move_character(doc, asset, xy, t, gesture=gesture)
                 return make
 
-            cx, cy = m2.position_channel_ids(asset)
+            cx, cy = character2d.position_channel_ids(asset)
             return [DofSpec("x", tx, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(0), "", cx),
                     DofSpec("y", ty, -TRANSLATION_LIMIT, TRANSLATION_LIMIT, move(1), "", cy)]
         index = runtime.joint_index(joint)
-        angle = float(np.asarray(m2.joint_angles(doc, asset, time, block=False))[index])
+        angle = float(np.asarray(character2d.joint_angles(doc, asset, time, block=False))[index])
 
         def key(value: float, t: float, gesture: object) -> Command:
-            return m2.key_joint(doc, asset, index, math.radians(value), t, gesture=gesture)
+            return character2d.key_joint(doc, asset, index, math.radians(value), t, gesture=gesture)
 
         def preview(value: float, t: float) -> dict[str, float]:
             # Clamped, and a pendulum's channel holds its world angle (as keying does).
-            return dict(m2.joint_value(doc, asset, index, math.radians(value), t))
+            return dict(character2d.joint_value(doc, asset, index, math.radians(value), t))
 
         # The slider (and typed values) span the joint's limits when it has some.
-        limit = m2.joint_limits(doc, asset)[index]
+        limit = character2d.joint_limits(doc, asset)[index]
         lo, hi = (-360.0, 360.0) if limit is None else (math.degrees(limit[0]), math.degrees(limit[1]))
         return [DofSpec("angle", math.degrees(angle), lo, hi, key, "°",
-                        m2.angle_channel_id(asset, joint), math.radians, preview)]
-    if m3 is not None and kind == m3.ASSET_KIND and runtime is not None:
-        return _dof_specs_3d(m3, doc, asset, joint, time)
+                        character2d.angle_channel_id(asset, joint), math.radians, preview)]
+    if kind == character3d.ASSET_KIND and runtime is not None:
+        return _dof_specs_3d(doc, asset, joint, time)
     return []
 
 
-def _dof_specs_3d(m3: ModuleType, doc: Document, asset: str, joint: str, time: float) -> list[DofSpec]:
+def _dof_specs_3d(doc: Document, asset: str, joint: str, time: float) -> list[DofSpec]:
     """A 3D character's root translation (joint ""), or a joint's rotation (Euler angles in
     its rotation order, also for a joint keyed as a quaternion), translation and scale.
 
     Every DOF keys through ``set_dof_command`` and previews (auto-key off) through
     ``dof_values``, which turn one Euler angle of a quaternion joint into its four components."""
-    posed = m3.pose_skeleton(doc, asset, time)
+    posed = character3d.pose_skeleton(doc, asset, time)
 
     def dof(key: tuple[int | None, str], scale: Callable[[float], float],
             ) -> tuple[Callable[[float, float, object], Command], Callable[[float, float], dict[str, float]]]:
         def make(value: float, t: float, gesture: object) -> Command:
-            return m3.set_dof_command(doc, asset, key[0], key[1], scale(value), t, gesture=gesture)
+            return character3d.set_dof_command(doc, asset, key[0], key[1], scale(value), t, gesture=gesture)
 
         def preview(value: float, t: float) -> dict[str, float]:
-            return dict(m3.dof_values(doc, asset, {key: scale(value)}, t))
+            return dict(character3d.dof_values(doc, asset, {key: scale(value)}, t))
 
         return make, preview
 
@@ -204,7 +183,7 @@ def _dof_specs_3d(m3: ModuleType, doc: Document, asset: str, joint: str, time: f
         for axis_i, axis in enumerate("xyz"):
             make, preview = dof((None, "t" + axis), float)
             specs.append(DofSpec(f"translate {axis}", float(posed.root_translation[axis_i]), -TRANSLATION_LIMIT,
-                                 TRANSLATION_LIMIT, make, "", m3.dof_channel_id(doc, asset, None, axis),
+                                 TRANSLATION_LIMIT, make, "", character3d.dof_channel_id(doc, asset, None, axis),
                                  preview=preview))
         return specs
     keys = posed.joint_keys()
@@ -228,9 +207,9 @@ def _dof_specs_3d(m3: ModuleType, doc: Document, asset: str, joint: str, time: f
         lo, hi = max(lo, -bound), min(hi, bound) if math.isfinite(hi) else bound
         make, preview = dof((index, axis), math.radians)
         specs.append(DofSpec(f"rotate {axis}", math.degrees(float(d.value)), math.degrees(lo), math.degrees(hi),
-                             make, "°", m3.dof_channel_id(doc, asset, index, axis), math.radians, preview))
+                             make, "°", character3d.dof_channel_id(doc, asset, index, axis), math.radians, preview))
     if j.translates or j.scales:
-        rest = m3.character(doc, asset).skeleton
+        rest = character3d.character(doc, asset).skeleton
     if j.translates:
         # The slider spans the skeleton's size either side of the rest position (fine enough
         # to drag); a typed value may go anywhere.
@@ -240,7 +219,7 @@ def _dof_specs_3d(m3: ModuleType, doc: Document, asset: str, joint: str, time: f
             make, preview = dof((index, "t" + axis), float)
             middle = float(rest.joints[index].translation[axis_i])
             specs.append(DofSpec(f"translate {axis}", float(j.translation[axis_i]), middle - reach, middle + reach,
-                                 make, "", m3.dof_channel_id(doc, asset, index, "t" + axis), preview=preview,
+                                 make, "", character3d.dof_channel_id(doc, asset, index, "t" + axis), preview=preview,
                                  steps=steps, decimals=_decimals(steps),
                                  typed_range=(-TRANSLATION_LIMIT * reach, TRANSLATION_LIMIT * reach)))
     if j.scales:
@@ -250,7 +229,7 @@ def _dof_specs_3d(m3: ModuleType, doc: Document, asset: str, joint: str, time: f
         for axis_i, axis in enumerate("xyz"):
             make, preview = dof((index, "s" + axis), float)
             specs.append(DofSpec(f"scale {axis}", float(j.scale[axis_i]), lo, hi, make, "",
-                                 m3.dof_channel_id(doc, asset, index, "s" + axis), preview=preview, steps=100,
+                                 character3d.dof_channel_id(doc, asset, index, "s" + axis), preview=preview, steps=100,
                                  decimals=2))
     return specs
 
@@ -293,18 +272,17 @@ def joint_names(doc: Document, asset: str) -> list[tuple[str, int | None, bool]]
 def reset_pose_command(doc: Document, asset: str, time: float, gesture: object = None) -> Command | None:
     """Every joint of ``asset`` back to its rest angle, keyed at ``time`` (one step)."""
     kind = _asset_kind(doc, asset)
-    m2, m3 = c2d(), c3d()
     commands: list[Command] = []
-    if m2 is not None and kind == m2.ASSET_KIND:
+    if kind == character2d.ASSET_KIND:
         n = len(doc.runtime[asset].joints)
         for j in range(n):
-            cmd = m2.key_joint(doc, asset, j, 0.0, time, gesture=gesture)
+            cmd = character2d.key_joint(doc, asset, j, 0.0, time, gesture=gesture)
             cmd.do(doc)  # later keys build on this one; undone below
             commands.append(cmd)
-    elif m3 is not None and kind == m3.ASSET_KIND:
+    elif kind == character3d.ASSET_KIND:
         # Course skeletons reset to zero angles (CSE169's R); a glTF character to the
         # file's rest pose, translations and scales included.
-        skel = m3.character(doc, asset).skeleton
+        skel = character3d.character(doc, asset).skeleton
         rest_from_file = skel.dialect == "gltf"
         values: dict[tuple[int | None, str | int], float] = {}
         for j, joint in enumerate(skel.joints):
@@ -315,7 +293,7 @@ def reset_pose_command(doc: Document, asset: str, time: float, gesture: object =
                 if joint.scales:
                     values[(j, "s" + axis)] = float(joint.scale[a])
         if values:
-            return Macro("Reset Pose", [m3.set_dofs_command(doc, asset, values, time, gesture=gesture)])
+            return Macro("Reset Pose", [character3d.set_dofs_command(doc, asset, values, time, gesture=gesture)])
     for cmd in reversed(commands):
         cmd.undo(doc)
     return Macro("Reset Pose", commands) if commands else None
@@ -779,9 +757,8 @@ class JointTree(QTreeWidget):
             action.triggered.connect(lambda _c=False: slot())
             return action
 
-        m2, m3 = c2d(), c3d()
         kind = _asset_kind(doc, target)
-        character = kind in {m.ASSET_KIND for m in (m2, m3) if m is not None}
+        character = kind in (character2d.ASSET_KIND, character3d.ASSET_KIND)
         add("outlinerFrame", "Frame in View", lambda: self.frame_in_view(target), not light)
         add("outlinerResetPose", "Reset Pose", lambda: self._reset_pose(target), character)
         menu.addSeparator()
@@ -805,11 +782,10 @@ class JointTree(QTreeWidget):
         """Show the editor that draws ``asset`` and fit its view to it: the 2D editor for a
         2D character, the 3D view for the rest."""
         window = self.window()
-        m2 = c2d()
         doc = self.ctx.doc
         if asset not in doc.assets:
             return False
-        if m2 is not None and _asset_kind(doc, asset) == m2.ASSET_KIND:
+        if _asset_kind(doc, asset) == character2d.ASSET_KIND:
             editor = getattr(window, "rig_editor", None)
             if editor is None:
                 return False
@@ -826,10 +802,9 @@ class JointTree(QTreeWidget):
 
     def reparent(self, source: tuple[str, str], target: tuple[str, str]) -> bool:
         """Make ``target`` (asset, joint) the parent of ``source``: one undo step."""
-        m2 = c2d()
         asset, joint = source
         doc = self.ctx.doc
-        if m2 is None or _asset_kind(doc, asset) != m2.ASSET_KIND:
+        if _asset_kind(doc, asset) != character2d.ASSET_KIND:
             return self._say("Only the joints of 2D characters can be re-parented here.")
         if target[0] != asset:
             return self._say("A joint can only hang from a joint of its own character.")
@@ -857,14 +832,13 @@ class JointTree(QTreeWidget):
         self.clear()
         self._items.clear()
         doc = self.ctx.doc
-        m2, m3 = c2d(), c3d()
         for aid, asset in doc.assets.items():
             top = QTreeWidgetItem([aid])
             top.setData(0, ROLE, (aid, ""))
             top.setData(0, KIND_ROLE, "asset")
             top.setFlags(top.flags() | Qt.ItemFlag.ItemIsEditable)
-            icon = ("character" if m2 is not None and asset.kind == m2.ASSET_KIND
-                    else "skeleton" if m3 is not None and asset.kind == m3.ASSET_KIND
+            icon = ("character" if asset.kind == character2d.ASSET_KIND
+                    else "skeleton" if asset.kind == character3d.ASSET_KIND
                     else "cloth" if asset.kind == "cloth" else "")
             if icon:
                 top.setIcon(0, self.icons[icon])

@@ -21,16 +21,17 @@ from PySide6.QtWidgets import (
 
 from qtanimator.document.commands import SetParameter
 from qtanimator.document.document import DocumentChange
-from qtanimator.render.gl.lights import AMBIENT_PARAMETER, LIGHT_NAMES, parameter
+from qtanimator.document.parameters import AMBIENT_PARAMETER, LIGHT_NAMES, LIGHTS
+from qtanimator.render.gl.lights import parameter
 from qtanimator.ui.context import EditorContext
+from qtanimator.ui.param_fields import spin_for
 from qtanimator.ui.widgets import CheckedDoubleSpinBox
 
 _gestures = itertools.count(1)
-#: Field ranges. A light's intensity is any number ≥ 0 (above 1 it brightens past its
-#: colour, which is fine) and its position any place: the maximums are far beyond use.
-#: A typed value outside them is refused with the reason shown, never clamped.
-INTENSITY_LIMIT = 1000.0
-POSITION_LIMIT = 1e6
+# The fields' ranges, steps, decimals and labels come from the parameter schema
+# (qtanimator.document.parameters.LIGHTS): a light's intensity is any number ≥ 0 and its
+# position any place (the maximums are far beyond use). A typed value outside them is
+# refused with the reason shown, never clamped.
 
 
 def _to_qcolor(rgb: Any) -> QColor:
@@ -74,15 +75,12 @@ class LightPanel(QWidget):
         for i, name in enumerate(LIGHT_NAMES, start=1):
             box = QGroupBox(f"Light {i}", self)
             form = QFormLayout(box)
+            position = LIGHTS[f"{name}.position"]
             row = QHBoxLayout()
-            spins = []
+            spins: list[CheckedDoubleSpinBox] = []
             for axis in "xyz":
-                s = CheckedDoubleSpinBox(box, label=f"Light {i} position {axis}")
-                s.setObjectName(f"{name}_position_{axis}")
-                s.setRange(-POSITION_LIMIT, POSITION_LIMIT)
-                s.setDecimals(2)
-                s.setSingleStep(0.1)
-                s.setKeyboardTracking(False)
+                s = spin_for(position, box, f"{name}_position_{axis}", f"{position.label} {axis}")
+                assert isinstance(s, CheckedDoubleSpinBox)
                 s.valueChanged.connect(lambda _v, n=name: self._position_edited(n))
                 s.editingFinished.connect(self.end_gesture)
                 row.addWidget(s)
@@ -91,14 +89,11 @@ class LightPanel(QWidget):
             form.addRow("Position", row)
             self.color[name] = ColorButton(self, f"{name}.color")
             form.addRow("Colour", self.color[name])
-            inten = CheckedDoubleSpinBox(box, label=f"Light {i} intensity")
-            inten.setObjectName(f"{name}_intensity")
-            inten.setRange(0.0, INTENSITY_LIMIT)
-            inten.setDecimals(2)
-            inten.setSingleStep(0.05)
-            # A typed value is one edit on Enter: with a command per keystroke, the refresh
-            # after "1" rewrote the field to "1.00" under the typing and "1.5" became 1.0.
-            inten.setKeyboardTracking(False)
+            # A typed value is one edit on Enter (spin_for turns keyboard tracking off): with a
+            # command per keystroke, the refresh after "1" rewrote the field to "1.00" under
+            # the typing and "1.5" became 1.0.
+            inten = spin_for(LIGHTS[f"{name}.intensity"], box, f"{name}_intensity")
+            assert isinstance(inten, CheckedDoubleSpinBox)
             inten.valueChanged.connect(lambda v, n=name: self._push(f"{n}.intensity", float(v)))
             inten.editingFinished.connect(self.end_gesture)
             self.intensity[name] = inten

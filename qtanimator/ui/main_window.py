@@ -48,6 +48,7 @@ EDITOR_MODULES: list[str] = [
     "qtanimator.ui.rig_editor",
     "qtanimator.ui.viewport",
     "qtanimator.ui.import3d",
+    "qtanimator.ui.spine",
     "qtanimator.ui.timeline",
     "qtanimator.ui.joint_tree",
     "qtanimator.ui.properties",
@@ -121,8 +122,7 @@ class MainWindow(QMainWindow):
             if install_editors is True or (install_editors and short in install_editors):
                 importlib.import_module(name).install(self)
         # The undo stack is cleared while the window is destroyed: ignore that signal then.
-        self.ctx.undo_stack.cleanChanged.connect(
-            lambda _clean: shiboken6.isValid(self) and self._update_title())
+        self.ctx.undo_stack.cleanChanged.connect(self._on_clean_changed)
         self.ctx.documentReset.connect(self._update_title)
         self._default_layout()
         self._restore_layout()
@@ -295,12 +295,7 @@ class MainWindow(QMainWindow):
             if opener is not None:
                 opener(self, p)
             elif p.suffix.lower() in (PROJECT_SUFFIX, ".json"):
-                doc, relinks = open_document_relinked(p, self.locate_missing_file)
-                self._relinked_unsaved = bool(relinks)
-                self.ctx.replace_document(doc)
-                self.restore_view_state()
-                if relinks:
-                    self._tell_relinked(relinks)
+                self.open_project(p)
             else:
                 raise FormatError("qtanimator does not know this kind of file.", p)
         except FormatError as exc:
@@ -314,6 +309,15 @@ class MainWindow(QMainWindow):
         self._remember_recent(p)
         self._update_title()
         return True
+
+    def open_project(self, p: Path) -> None:
+        """Replace the document with the project ``p`` (FormatError / OSError: unchanged)."""
+        doc, relinks = open_document_relinked(p, self.locate_missing_file)
+        self._relinked_unsaved = bool(relinks)
+        self.ctx.replace_document(doc)
+        self.restore_view_state()
+        if relinks:
+            self._tell_relinked(relinks)
 
     def save(self) -> bool:
         if self.doc.path is None:
@@ -461,7 +465,9 @@ class MainWindow(QMainWindow):
         value = settings().value("recentFiles", [])
         if isinstance(value, str):
             value = [value]
-        return [str(v) for v in (value or [])]
+        if not isinstance(value, (list, tuple)):
+            return []  # nothing stored (an empty list reads back as None)
+        return [str(v) for v in value]
 
     def _remember_recent(self, path: Path) -> None:
         s = settings()
@@ -488,6 +494,10 @@ class MainWindow(QMainWindow):
             action.setToolTip(path)
             action.triggered.connect(lambda _c=False, p=path: self.open_with_prompt(p))
         self.recent_menu.setEnabled(bool(self.recent_files()))
+
+    def _on_clean_changed(self, _clean: bool) -> None:
+        if shiboken6.isValid(self):  # the stack is cleared while the window is destroyed
+            self._update_title()
 
     def _update_title(self) -> None:
         name = Path(self.doc.path).name if self.doc.path else "untitled"

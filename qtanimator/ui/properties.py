@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import fields, replace
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -31,62 +31,24 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from qtanimator.document.character2d import IK_DEFAULTS, ik_setting
+from qtanimator.document import character2d, character3d
+from qtanimator.document.character2d import ik_setting
 from qtanimator.document.commands import SetParameter
 from qtanimator.document.document import DocumentChange
-from qtanimator.document.ik_settings import BEND_DIRECTIONS, IK_SOLVERS
+from qtanimator.document.parameters import IK, PENDULUM, SPRING, Param
 from qtanimator.ui.clip_picker import ClipCombo, clip_characters
 from qtanimator.ui.context import EditorContext
-from qtanimator.ui.joint_tree import c2d, c3d
+from qtanimator.ui.param_fields import editor_for, spin_for
 from qtanimator.ui.widgets import CheckedDoubleSpinBox, CheckedSpinBox, format_number
 
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
 
-#: Labels in the animator's words, and tool tips that keep the physics and course names.
-PENDULUM_LABELS: dict[str, tuple[str, str]] = {
-    "g": ("Gravity", "g, in scene units per second² (pulls down the screen)"),
-    "damping": ("Damping", "how fast the swing dies out: a in ω ← ω·e^(−a·τ), per second"),
-    "restitution": ("Bounce", "restitution e: the share of its speed a pendulum or spring joint keeps when it hits "
-                              "its joint limits (0 stops dead, 1 bounces back fully)"),
-    "length_scale": ("Length scale", "multiplies the pivot-to-centre-of-mass lengths (the course handout uses 1/1000)"),
-    "accel_scale": ("Follow the body", "how much the character's movement swings the pendulums "
-                                       "(translation acceleration scale)"),
-    "rotation_accel_scale": ("Follow the parent's rotation", "how much keyframed parents turning swings the "
-                                                              "pendulums (rotation acceleration scale)"),
-    "inertia": ("Inertia from", "exact: from the drawn shapes; reference: the course starter's formulas"),
-    "point_mass_forcing": ("Point-mass swing", "the course handout's 1/L² forcing in place of m/I"),
-    "coupled": ("Chains swing together", "solve chains of pendulums as one coupled system"),
-    "integrator": ("Integrator", "symplectic Euler (the course's), leapfrog or Runge–Kutta 4"),
-    "step": ("Simulation step (s)", "the fixed internal time step; smaller is steadier and slower"),
-}
-SPRING_LABELS: dict[str, tuple[str, str]] = {
-    "stiffness": ("Stiffness", "how hard the spring pulls the joint back to its keyed angle (k, per second²; "
-                               "it wobbles at √k / 2π per second)"),
-    "damping": ("Damping", "how fast the wobble dies out (c, per second; none left at 2√k)"),
-    "mix": ("Mix", "0 shows the keys, 1 the spring; in between, a blend"),
-    "inertia": ("Inertia", "how much the parent turning and the body moving drag the joint (0: it rides on its "
-                           "parent, 1: it keeps its heading like a loose part)"),
-}
+# Labels in the animator's words, tool tips that keep the physics and course names, units,
+# ranges and choices of the IK, pendulum and spring settings: the parameter schema
+# (qtanimator.document.parameters IK, PENDULUM, SPRING).
 #: What drives a 2D joint, in the animator's words (``rigging.JOINT_MODES``).
 JOINT_MODE_LABELS = {"keyframed": "Keys", "dynamic": "Pendulum (physics)", "spring": "Spring (follows keys)"}
-IK_LABELS: dict[str, tuple[str, str]] = {
-    "ik.solver": ("Solver", "dls: damped least squares (recommended); ccd: cyclic coordinate descent, one joint "
-                            "at a time; fabrik: forward and backward reaching, on positions; handout: the course "
-                            "handout's gradient descent (2D). All respect joint limits"),
-    "ik.two_bone": ("Two-bone chains exactly", "a chain with exactly two moving joints is solved exactly "
-                                               "(law of cosines), whatever the solver"),
-    "ik.bend_direction": ("Two-bone bend", "keep: the middle joint bends to the side it bends to now; "
-                                           "positive / negative: counter-clockwise / clockwise on screen (2D)"),
-    "ik.freeze_root": ("Keep the root still", "the dragged chain stops below the character's root joint"),
-    "ik.max_iterations": ("Precision (iterations)", "more iterations reach the cursor more exactly"),
-    "ik.damping": ("Smoothness", "damped least squares' damping λ: higher is steadier near full stretch"),
-    "ik.handout_step": ("Gradient step (handout solver)", "τ in the handout's update θ ← θ + τ·D"),
-    "ik.handout_iterations": ("Gradient steps per move (handout solver)", "updates of the handout's solver "
-                                                                          "per mouse move"),
-    "ik.gradient_arrow_scale": ("Debug arrow length", "length of the gradient arrows of the debug overlay"),
-}
-IK_CHOICES = {"ik.solver": list(IK_SOLVERS), "ik.bend_direction": list(BEND_DIRECTIONS)}
 #: How far the joint limit fields go either way (degrees): two turns.
 LIMIT_RANGE_DEGREES = 720.0
 
@@ -100,9 +62,9 @@ class PropertiesPanel(QWidget):
         self.ctx = ctx
         outer = QVBoxLayout(self)
         outer.setContentsMargins(0, 0, 0, 0)
-        self.scroll = QScrollArea(self)
-        self.scroll.setWidgetResizable(True)
-        outer.addWidget(self.scroll)
+        self.scroll_area = QScrollArea(self)
+        self.scroll_area.setWidgetResizable(True)
+        outer.addWidget(self.scroll_area)
         self.body: QWidget | None = None
         self._simulation_refreshers: list[Callable[[], None]] = []
         self._refreshers: list[Callable[[], None]] = []
@@ -145,9 +107,8 @@ class PropertiesPanel(QWidget):
         layout = QVBoxLayout(body)
         asset, joint = self.ctx.selection
         doc = self.ctx.doc
-        m2, m3 = c2d(), c3d()
         kind = doc.assets[asset].kind if asset in doc.assets else ""
-        if m2 is not None and kind == m2.ASSET_KIND and asset in doc.runtime:
+        if kind == character2d.ASSET_KIND and asset in doc.runtime:
             if joint:
                 layout.addWidget(self._joint2d_group(asset, joint))
             layout.addWidget(self._character2d_group(asset))
@@ -156,7 +117,7 @@ class PropertiesPanel(QWidget):
             if bool(doc.runtime[asset].spring.any()):
                 layout.addWidget(self._spring_group(asset))
             layout.addWidget(self._placement_group(asset, 2))
-        elif m3 is not None and kind == m3.ASSET_KIND and asset in doc.runtime:
+        elif kind == character3d.ASSET_KIND and asset in doc.runtime:
             layout.addWidget(self._joint3d_group(asset, joint))
             layout.addWidget(self._placement_group(asset, 3))
         elif not asset:
@@ -165,7 +126,7 @@ class PropertiesPanel(QWidget):
             layout.addWidget(label)
         layout.addWidget(self._ik_group())
         layout.addStretch(1)
-        self.scroll.setWidget(body)  # deletes the previous body
+        self.scroll_area.setWidget(body)  # deletes the previous body
         self.body = body
         self.refresh()
 
@@ -187,15 +148,24 @@ class PropertiesPanel(QWidget):
 
     def _parameter_editor(self, form: QFormLayout, title: str, path: str, default: Any,
                           choices: list[str] | None = None, decimals: int = 4,
-                          check: Callable[[Any], str | None] | None = None) -> QWidget:
+                          check: Callable[[Any], str | None] | None = None,
+                          param: Param | None = None) -> QWidget:
         """An editor for one document parameter; every change is a SetParameter.
 
-        ``check(value)`` gives the reason a value is refused (None: accepted): the
-        parameter's own definition decides (e.g. :class:`PendulumParams`); a refused value
-        leaves the document as it was and the field says why."""
+        With a schema ``param`` the field is built from it (``param_fields``: kind, range,
+        step, decimals, choices, reasons); without, from ``default``'s type. ``check(value)``
+        gives the reason a value is refused (None: accepted): the parameter's own definition
+        decides (e.g. :class:`PendulumParams`), after the schema's range (``SetParameter``
+        validates too); a refused value leaves the document as it was and the field says why."""
         doc = self.ctx.doc
         name = "param_" + path.replace(".", "_")
         widget: QWidget
+        if param is not None:
+            kind = param.kind
+            choices = list(param.choices) if kind == "choice" else None
+        else:
+            kind = ("choice" if choices is not None else "bool" if isinstance(default, bool)
+                    else "int" if isinstance(default, int) else "float")
 
         def current() -> Any:
             return doc.parameter(path, default)
@@ -208,12 +178,23 @@ class PropertiesPanel(QWidget):
                     widget.refuse(f"{title}: {reason}")  # ...and why the typed one was refused
                 return
             if current() != value:
-                self.ctx.push(SetParameter(doc, path, value, text=f"Set {title}", gesture=("properties", path,
-                                                                                           object())))
+                try:
+                    command = SetParameter(doc, path, value, text=f"Set {title}", gesture=("properties", path,
+                                                                                          object()))
+                except ValueError as exc:  # the schema refuses it
+                    self.refresh()
+                    if isinstance(widget, (CheckedSpinBox, CheckedDoubleSpinBox)):
+                        widget.refuse(str(exc))
+                    return
+                self.ctx.push(command)
 
-        if choices is not None:
-            combo = QComboBox()
-            combo.addItems(choices)
+        if kind == "choice":
+            if param is not None:
+                combo = editor_for(param)
+                assert isinstance(combo, QComboBox)
+            else:
+                combo = QComboBox()
+                combo.addItems(choices or [])
             combo.currentTextChanged.connect(push)
 
             def refresh_combo() -> None:
@@ -223,7 +204,7 @@ class PropertiesPanel(QWidget):
 
             self._refreshers.append(refresh_combo)
             widget = combo
-        elif isinstance(default, bool):
+        elif kind == "bool":
             box = QCheckBox()
             box.toggled.connect(lambda on: push(bool(on)))
 
@@ -234,10 +215,16 @@ class PropertiesPanel(QWidget):
 
             self._refreshers.append(refresh_check)
             widget = box
-        elif isinstance(default, int):
-            spin = CheckedSpinBox(label=title)
-            spin.setRange(0, 1_000_000)
-            spin.setKeyboardTracking(False)
+        elif kind == "int":
+            spin: CheckedSpinBox
+            if param is not None:
+                made = spin_for(param, label=title)
+                assert isinstance(made, CheckedSpinBox)
+                spin = made
+            else:
+                spin = CheckedSpinBox(label=title)
+                spin.setRange(0, 1_000_000)
+                spin.setKeyboardTracking(False)
             spin.valueChanged.connect(lambda v: push(int(v)))
 
             def refresh_int() -> None:
@@ -248,12 +235,18 @@ class PropertiesPanel(QWidget):
             self._refreshers.append(refresh_int)
             widget = spin
         else:
-            dspin = CheckedDoubleSpinBox(label=title)
-            dspin.setDecimals(decimals if abs(float(default)) >= 1e-3 or default == 0 else 9)
-            dspin.setRange(-1e9, 1e9)
-            dspin.setKeyboardTracking(False)
-            magnitude = abs(float(default)) or 1.0
-            dspin.setSingleStep(10 ** math.floor(math.log10(magnitude)))
+            dspin: CheckedDoubleSpinBox
+            if param is not None:
+                dmade = spin_for(param, label=title)
+                assert isinstance(dmade, CheckedDoubleSpinBox)
+                dspin = dmade
+            else:
+                dspin = CheckedDoubleSpinBox(label=title)
+                dspin.setDecimals(decimals if abs(float(default)) >= 1e-3 or default == 0 else 9)
+                dspin.setRange(-1e9, 1e9)
+                dspin.setKeyboardTracking(False)
+                magnitude = abs(float(default)) or 1.0
+                dspin.setSingleStep(10 ** math.floor(math.log10(magnitude)))
             dspin.valueChanged.connect(lambda v: push(float(v)))
 
             def refresh_float() -> None:
@@ -271,8 +264,6 @@ class PropertiesPanel(QWidget):
     # ---------------------------------------------------------------- groups
     def _joint2d_group(self, asset: str, joint: str) -> QGroupBox:
         doc = self.ctx.doc
-        m2 = c2d()
-        assert m2 is not None
         character = doc.runtime[asset]
         index = character.joint_index(joint)
         j = character.joints[index]
@@ -295,7 +286,7 @@ class PropertiesPanel(QWidget):
         form.addRow("Pendulum length L", QLabel(f"{float(np.hypot(*(com - j.pivot))):.3f}"))
 
         def angle() -> str:
-            a = float(np.asarray(m2.joint_angles(doc, asset, self.ctx.time, block=False))[index])
+            a = float(np.asarray(character2d.joint_angles(doc, asset, self.ctx.time, block=False))[index])
             return f"{math.degrees(a):.3f}°"
 
         self._label(form, "Angle (local)", angle, "jointAngle")
@@ -309,8 +300,6 @@ class PropertiesPanel(QWidget):
         (with a range that holds the angle shown) or off, the fields edit one bound each;
         every change is one undo step (``character2d.set_joint_limits_command``)."""
         doc = self.ctx.doc
-        m2 = c2d()
-        assert m2 is not None
         enabled = QCheckBox("Limit rotation")
         enabled.setObjectName("jointLimitsEnabled")
         enabled.setToolTip("keep the joint's angle relative to its parent within a range: IK, dragging, the "
@@ -332,11 +321,11 @@ class PropertiesPanel(QWidget):
         self.editors["joint_limits"] = enabled
 
         def current() -> tuple[float, float] | None:
-            return m2.joint_limits(doc, asset)[index]  # type: ignore[no-any-return]
+            return character2d.joint_limits(doc, asset)[index]
 
         def free_range() -> tuple[float, float]:
             """What the fields offer while the joint is free: ±90° widened to the angle shown."""
-            a = math.degrees(float(np.asarray(m2.joint_angles(doc, asset, self.ctx.time, block=False))[index]))
+            a = math.degrees(float(np.asarray(character2d.joint_angles(doc, asset, self.ctx.time, block=False))[index]))
             return min(-90.0, math.floor(a)), max(90.0, math.ceil(a))
 
         def refresh() -> None:
@@ -356,9 +345,9 @@ class PropertiesPanel(QWidget):
                 lo, hi = boxes[0].value(), boxes[1].value()
                 if lo > hi:
                     lo, hi = free_range()
-                command = m2.set_joint_limits_command(doc, asset, index, math.radians(lo), math.radians(hi))
+                command = character2d.set_joint_limits_command(doc, asset, index, math.radians(lo), math.radians(hi))
             else:
-                command = m2.set_joint_limits_command(doc, asset, index, None, None)
+                command = character2d.set_joint_limits_command(doc, asset, index, None, None)
             self.ctx.push(command)
 
         def edited(which: int) -> None:
@@ -372,7 +361,7 @@ class PropertiesPanel(QWidget):
                 boxes[which].refuse("The minimum angle cannot be above the maximum angle.")
                 return
             if tuple(bounds) != limit:
-                self.ctx.push(m2.set_joint_limits_command(doc, asset, index, bounds[0], bounds[1]))
+                self.ctx.push(character2d.set_joint_limits_command(doc, asset, index, bounds[0], bounds[1]))
 
         enabled.toggled.connect(toggled)
         boxes[0].valueChanged.connect(lambda _v: edited(0))
@@ -381,8 +370,6 @@ class PropertiesPanel(QWidget):
 
     def _character2d_group(self, asset: str) -> QGroupBox:
         doc = self.ctx.doc
-        m2 = c2d()
-        assert m2 is not None
         character = doc.runtime[asset]
         group = QGroupBox(f"Character: {asset}")
         group.setObjectName("characterProperties")
@@ -396,24 +383,22 @@ class PropertiesPanel(QWidget):
         form.addRow("Total mass", QLabel(f"{mass:.6g}"))
 
         def position() -> str:
-            t = m2.translation(doc, asset, self.ctx.time)
+            t = character2d.translation(doc, asset, self.ctx.time)
             return f"({t[0]:.2f}, {t[1]:.2f})"
 
         def velocity() -> str:
-            t = m2.translation(doc, asset, self.ctx.time, 1)
+            t = character2d.translation(doc, asset, self.ctx.time, 1)
             return f"({t[0]:.2f}, {t[1]:.2f}) /s"
 
         self._label(form, "Position", position, "characterPosition")
         self._label(form, "Velocity", velocity, "characterVelocity")
-        key_all = getattr(m2, "KEY_ALL_PARAMETER", "animation.key_all")
+        key_all = character2d.KEY_ALL_PARAMETER
         self._parameter_editor(form, "Key every joint (universal keyframe)", key_all, False)
         return group
 
     def _pendulum_group(self, asset: str) -> QGroupBox:
         doc = self.ctx.doc
-        m2 = c2d()
-        assert m2 is not None
-        from qtanimator.core.pendulum import INTEGRATORS, PRESETS, PendulumParams
+        from qtanimator.core.pendulum import PRESETS
 
         group = QGroupBox("Pendulums")
         group.setObjectName("pendulumProperties")
@@ -424,7 +409,7 @@ class PropertiesPanel(QWidget):
         preset.addItem("custom")
 
         def current_preset() -> str:
-            params = m2.pendulum_params(doc, asset)
+            params = character2d.pendulum_params(doc, asset)
             for name, p in PRESETS.items():
                 if p == params:
                     return name
@@ -432,7 +417,7 @@ class PropertiesPanel(QWidget):
 
         def apply_preset(name: str) -> None:
             if name in PRESETS and name != current_preset():
-                self.ctx.push(m2.set_pendulum_preset(doc, asset, name))
+                self.ctx.push(character2d.set_pendulum_preset(doc, asset, name))
 
         def refresh_preset() -> None:
             preset.blockSignals(True)
@@ -443,29 +428,21 @@ class PropertiesPanel(QWidget):
         self._refreshers.append(refresh_preset)
         self.editors["preset"] = preset
         form.addRow("Preset", preset)
-        defaults = PendulumParams()
-        for f in fields(PendulumParams):
-            path = f"{asset}.pendulum.{f.name}"
-            default = getattr(m2.pendulum_params(doc, asset), f.name)
-            choices = None
-            if f.name == "inertia":
-                choices = ["exact", "reference"]
-            elif f.name == "integrator":
-                choices = list(INTEGRATORS)
-            label, tip = PENDULUM_LABELS.get(f.name, (f.name, ""))
-            editor = self._parameter_editor(form, label, path, default, choices, decimals=6,
-                                            check=self._pendulum_check(asset, f.name))
-            editor.setToolTip(f"{tip} (default {getattr(defaults, f.name)!r})" if tip else
-                              f"default {getattr(defaults, f.name)!r}")
+        for key, param in PENDULUM.items():
+            path = PENDULUM.path(key, asset)
+            default = getattr(character2d.pendulum_params(doc, asset), key)
+            editor = self._parameter_editor(form, param.label, path, default, check=self._pendulum_check(asset, key),
+                                            param=param)
+            editor.setToolTip(_tool_tip(param))
             # What is shown is the effective value (preset + overrides).
-            self._refreshers.append(self._effective_refresher(editor, asset, f.name))
+            self._refreshers.append(self._effective_refresher(editor, asset, key))
         problem = QLabel()
         problem.setObjectName("pendulumProblem")
         problem.setWordWrap(True)
         problem.setStyleSheet("color: #c0392b;")
 
         def refresh_problem() -> None:
-            report = m2.simulation(doc).problem(asset)
+            report = character2d.simulation(doc).problem(asset)
             problem.setText("" if report is None else f"Stopped: {report.message}")
             problem.setVisible(report is not None)
 
@@ -514,9 +491,7 @@ class PropertiesPanel(QWidget):
         """The character's spring constants: a preset and each value (document parameters
         ``<asset>.spring.<name>``)."""
         doc = self.ctx.doc
-        m2 = c2d()
-        assert m2 is not None
-        from qtanimator.core.spring_joint import SPRING_PRESETS, SpringParams
+        from qtanimator.core.spring_joint import SPRING_PRESETS
 
         group = QGroupBox("Springs")
         group.setObjectName("springProperties")
@@ -526,12 +501,12 @@ class PropertiesPanel(QWidget):
         preset.addItems([*SPRING_PRESETS, "custom"])
 
         def current_preset() -> str:
-            params = m2.spring_params(doc, asset)
+            params = character2d.spring_params(doc, asset)
             return next((name for name, p in SPRING_PRESETS.items() if p == params), "custom")
 
         def apply_preset(name: str) -> None:
             if name in SPRING_PRESETS and name != current_preset():
-                self.ctx.push(m2.set_spring_preset(doc, asset, name))
+                self.ctx.push(character2d.set_spring_preset(doc, asset, name))
 
         def refresh_preset() -> None:
             preset.blockSignals(True)
@@ -542,26 +517,24 @@ class PropertiesPanel(QWidget):
         self._refreshers.append(refresh_preset)
         self.editors["spring_preset"] = preset
         form.addRow("Preset", preset)
-        defaults = SpringParams()
-        for f in fields(SpringParams):
-            path = f"{asset}.spring.{f.name}"
-            label, tip = SPRING_LABELS.get(f.name, (f.name, ""))
+        for key, param in SPRING.items():
+            path = SPRING.path(key, asset)
 
-            def check(value: Any, name: str = f.name) -> str | None:
+            def check(value: Any, name: str = key) -> str | None:
                 try:
-                    replace(m2.spring_params(doc, asset), **{name: value})
+                    replace(character2d.spring_params(doc, asset), **{name: value})
                 except (TypeError, ValueError) as exc:
                     return str(exc)
                 return None
 
-            editor = self._parameter_editor(form, label, path, getattr(m2.spring_params(doc, asset), f.name),
-                                            decimals=4, check=check)
-            editor.setToolTip(f"{tip} (default {getattr(defaults, f.name)!r})")
+            value = getattr(character2d.spring_params(doc, asset), key)
+            editor = self._parameter_editor(form, param.label, path, value, check=check, param=param)
+            editor.setToolTip(_tool_tip(param))
 
-            def refresh(editor: QWidget = editor, name: str = f.name) -> None:
+            def refresh(editor: QWidget = editor, name: str = key) -> None:
                 if isinstance(editor, QDoubleSpinBox):
                     editor.blockSignals(True)
-                    editor.setValue(float(getattr(m2.spring_params(doc, asset), name)))
+                    editor.setValue(float(getattr(character2d.spring_params(doc, asset), name)))
                     editor.blockSignals(False)
 
             self._refreshers.append(refresh)
@@ -569,13 +542,11 @@ class PropertiesPanel(QWidget):
 
     def _pendulum_check(self, asset: str, name: str) -> Callable[[Any], str | None]:
         """The pendulum parameters' own validation (``PendulumParams``) as a field check."""
-        m2 = c2d()
-        assert m2 is not None
         doc = self.ctx.doc
 
         def check(value: Any) -> str | None:
             try:
-                replace(m2.pendulum_params(doc, asset), **{name: value})
+                replace(character2d.pendulum_params(doc, asset), **{name: value})
             except (TypeError, ValueError) as exc:
                 return str(exc)
             return None
@@ -583,12 +554,10 @@ class PropertiesPanel(QWidget):
         return check
 
     def _effective_refresher(self, editor: QWidget, asset: str, name: str) -> Callable[[], None]:
-        m2 = c2d()
-        assert m2 is not None
         doc = self.ctx.doc
 
         def refresh() -> None:
-            value = getattr(m2.pendulum_params(doc, asset), name)
+            value = getattr(character2d.pendulum_params(doc, asset), name)
             editor.blockSignals(True)
             if isinstance(editor, QComboBox):
                 editor.setCurrentText(str(value))
@@ -605,8 +574,7 @@ class PropertiesPanel(QWidget):
         group = QGroupBox(f"Joint: {joint}" if joint else f"Skeleton: {asset}")
         group.setObjectName("jointProperties")
         form = QFormLayout(group)
-        runtime = doc.runtime[asset]
-        skeleton = getattr(runtime, "skeleton", runtime)
+        skeleton = character3d.character(doc, asset).skeleton
         names = [j.name for j in skeleton.joints]
         if joint in names:
             j = skeleton.joints[names.index(joint)]
@@ -628,11 +596,10 @@ class PropertiesPanel(QWidget):
         are one undoable command each."""
         from qtanimator.document import cloth_attach as ca
 
-        m3 = c3d()
         doc = self.ctx.doc
-        if m3 is None or doc.assets[asset].kind != m3.ASSET_KIND:
+        if doc.assets[asset].kind != character3d.ASSET_KIND:
             return
-        defaults = ca.default_capsule_radii(m3.character(doc, asset))  # once: it reads the whole skin
+        defaults = ca.default_capsule_radii(character3d.character(doc, asset))  # once: it reads the whole skin
         if joint not in defaults:  # the root: no bone ends here
             return
 
@@ -754,22 +721,21 @@ class PropertiesPanel(QWidget):
     def _rotation_mode_editor(self, form: QFormLayout, asset: str) -> None:
         """How a 3D character's rotations are keyed (issue 21): quaternion curves (W X Y Z, as
         a glTF file has them) or Euler curves (X Y Z angles); one undoable conversion."""
-        m3 = c3d()
         doc = self.ctx.doc
-        if m3 is None or doc.assets[asset].kind != m3.ASSET_KIND:
+        if doc.assets[asset].kind != character3d.ASSET_KIND:
             return
         combo = QComboBox()
         combo.setObjectName("rotationMode")
         combo.addItems(["quaternion", "euler"])
-        combo.setCurrentText(m3.rotation_mode(m3.character(doc, asset)))
+        combo.setCurrentText(character3d.rotation_mode(character3d.character(doc, asset)))
         combo.setToolTip("How rotations are keyed: quaternion curves (W, X, Y, Z; slerp between keys, as glTF "
                          "files have them) or Euler curves (X, Y, Z angles). Switching converts the keys, "
                          "exact at every key and frame.")
 
         def push(value: str) -> None:
-            if value == m3.rotation_mode(m3.character(doc, asset)):
+            if value == character3d.rotation_mode(character3d.character(doc, asset)):
                 return
-            command = m3.set_rotation_mode_command(doc, asset, value)
+            command = character3d.set_rotation_mode_command(doc, asset, value)
             # The change rebuilds this panel, deleting the combo: push after its signal returns.
             QTimer.singleShot(0, lambda: self.ctx.push(command))
 
@@ -789,10 +755,9 @@ class PropertiesPanel(QWidget):
 
     def _bvh_positions_editor(self, form: QFormLayout, asset: str) -> None:
         """A BVH character's position convention (issue 21): one undoable command per change."""
-        m3 = c3d()
         doc = self.ctx.doc
-        current = m3.bvh_positions(doc, asset) if m3 is not None else None
-        if m3 is None or current is None:
+        current = character3d.bvh_positions(doc, asset)
+        if current is None:
             return
         combo = QComboBox()
         combo.setObjectName("bvhPositions")
@@ -803,13 +768,13 @@ class PropertiesPanel(QWidget):
                          "was opened.")
 
         def push(value: str) -> None:
-            if value == m3.bvh_positions(doc, asset):
+            if value == character3d.bvh_positions(doc, asset):
                 return
             try:
-                command = m3.set_bvh_positions_command(doc, asset, value)
+                command = character3d.set_bvh_positions_command(doc, asset, value)
             except (OSError, ValueError) as exc:  # FormatError is a ValueError: the file is gone or changed
                 combo.blockSignals(True)
-                combo.setCurrentText(str(m3.bvh_positions(doc, asset)))
+                combo.setCurrentText(str(character3d.bvh_positions(doc, asset)))
                 combo.blockSignals(False)
                 combo.setToolTip(f"Cannot switch: {exc}")
                 return
@@ -824,11 +789,17 @@ class PropertiesPanel(QWidget):
         group = QGroupBox("IK solver")
         group.setObjectName("ikProperties")
         form = QFormLayout(group)
-        for path, default in IK_DEFAULTS.items():
-            label, tip = IK_LABELS.get(path, (path, ""))
-            editor = self._parameter_editor(form, label, path, default, IK_CHOICES.get(path), decimals=6)
-            editor.setToolTip(tip)
+        for path, param in IK.items():
+            editor = self._parameter_editor(form, param.label, path, param.default, param=param)
+            editor.setToolTip(param.help)
         return group
+
+
+def _tool_tip(param: Param) -> str:
+    """A schema field's tool tip: its help, its unit and its default."""
+    default = f"{param.default:.6g}" if isinstance(param.default, float) else repr(param.default)
+    unit = f" {param.unit}" if param.unit else ""
+    return f"{param.help} (default {default}{unit})" if param.help else f"default {default}{unit}"
 
 
 def _limits_text(lo: float, hi: float) -> str:

@@ -47,7 +47,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from PySide6.QtCore import QPointF, QRectF, Qt
+from PySide6.QtCore import QPointF, QRect, QRectF, Qt
 from PySide6.QtGui import (
     QAction,
     QBrush,
@@ -80,10 +80,12 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
+from qtanimator.document import character2d
 from qtanimator.document import pose as pose_doc
 from qtanimator.document.commands import Command
 from qtanimator.document.document import DocumentChange
 from qtanimator.document.gesture import Gesture
+from qtanimator.render import painter2d
 from qtanimator.ui import rig_interaction as ri
 from qtanimator.ui.context import EditorContext
 
@@ -99,16 +101,9 @@ LIMIT_WEDGE_RADIUS_PX = 48.0
 LIMIT_WEDGE_COLOR = (255, 140, 0)
 
 
-def _c2d() -> Any:
-    from qtanimator.document import character2d
-
-    return character2d
-
-
-def _painter2d() -> Any:
-    from qtanimator.render import painter2d
-
-    return painter2d
+def _xy(point: np.ndarray) -> tuple[float, float]:
+    """A scene point (``RigEditorView.to_scene``) as the pair the interaction functions take."""
+    return float(point[0]), float(point[1])
 
 
 class JointSprites:
@@ -162,9 +157,9 @@ class JointSprites:
         painter = QPainter(image)
         painter.scale(scale, scale)
         painter.translate(-x0, -y0)
-        _painter2d().draw_character(painter, single, single.rest_pose(),
-                                    highlight=0 if state == "selected" else None,
-                                    hover=0 if state == "hover" else None)
+        painter2d.draw_character(painter, single, single.rest_pose(),
+                                 highlight=0 if state == "selected" else None,
+                                 hover=0 if state == "hover" else None)
         painter.end()
         return image, QRectF(x0, y0, w / scale, h / scale)
 
@@ -175,7 +170,6 @@ class JointSprites:
         if abs(scale - self._scale) > 1e-3 * max(scale, 1e-9):
             self._images.clear()
             self._scale = scale
-        p2d = _painter2d()
         painter.save()
         painter.setRenderHint(QPainter.RenderHint.SmoothPixmapTransform, True)
         cid = id(character)
@@ -187,10 +181,10 @@ class JointSprites:
             if key not in self._images:
                 self._images[key] = self._build(character, i, state, scale)
             sprite = self._images[key]
-            painter.setWorldTransform(p2d.joint_transform(pose, i) * base)
+            painter.setWorldTransform(painter2d.joint_transform(pose, i) * base)
             if sprite is None:
                 painter.restore()
-                p2d.draw_character(painter, character, pose, highlight=highlight, hover=hover)
+                painter2d.draw_character(painter, character, pose, highlight=highlight, hover=hover)
                 return
             painter.drawImage(sprite[1], sprite[0])
         painter.restore()
@@ -221,7 +215,7 @@ class CharacterItem(QGraphicsItem):
         if self.editor.use_sprites():
             self.editor.sprites.draw(painter, character, pose, highlight, hover)
         else:
-            _painter2d().draw_character(painter, character, pose, highlight=highlight, hover=hover)
+            painter2d.draw_character(painter, character, pose, highlight=highlight, hover=hover)
 
 
 class RigEditorView(QGraphicsView):
@@ -303,13 +297,12 @@ class RigEditorView(QGraphicsView):
         show the latest simulated state and are never simulated here: until the background
         worker reaches the frame, the poses are read again at each repaint."""
         if self._poses is None:
-            c2d = _c2d()
             doc, t = self.ctx.doc, self.ctx.time
-            self._poses_exact = c2d.simulation_ready(doc, t)  # checked first: the worker only adds
+            self._poses_exact = character2d.simulation_ready(doc, t)  # checked first: the worker only adds
             if self.rig_mode:
                 self._poses = ri.rig_poses(doc, t)
             else:
-                self._poses = {aid: c2d.evaluate_pose(doc, aid, t, block=False) for aid in self.character_ids()}
+                self._poses = {aid: character2d.evaluate_pose(doc, aid, t, block=False) for aid in self.character_ids()}
         return self._poses
 
     def selected_joint_index(self, asset: str) -> int | None:
@@ -318,7 +311,7 @@ class RigEditorView(QGraphicsView):
             return None
         character = self.ctx.doc.runtime.get(asset)
         asset_obj = self.ctx.doc.assets.get(asset)
-        if character is None or asset_obj is None or asset_obj.kind != _c2d().ASSET_KIND:
+        if character is None or asset_obj is None or asset_obj.kind != character2d.ASSET_KIND:
             return None  # this editor draws 2D characters only (a 3D joint may be selected)
         if joint == "":
             return 0
@@ -374,7 +367,7 @@ class RigEditorView(QGraphicsView):
     def scene_bounds(self) -> QRectF:
         if not self.character_ids():
             return QRectF()
-        return _painter2d().scene_bounds(self.ctx.doc, self.ctx.time)
+        return painter2d.scene_bounds(self.ctx.doc, self.ctx.time)
 
     def fit_view(self) -> None:
         rect = self.scene_bounds()
@@ -456,7 +449,7 @@ class RigEditorView(QGraphicsView):
             self._rig_press(event, point)
             return
         try:
-            hit = ri.pick(self.ctx.doc, time, point)
+            hit = ri.pick(self.ctx.doc, time, _xy(point))
         except ModuleNotFoundError:
             hit = None
         if hit is not None and button in (Qt.MouseButton.LeftButton, Qt.MouseButton.RightButton):
@@ -472,10 +465,10 @@ class RigEditorView(QGraphicsView):
             self.ctx.select(asset, "")
             if event.modifiers() & Qt.KeyboardModifier.ShiftModifier:
                 self._gesture = self._new_gesture(f"Scale {asset}")
-                self._drag = ri.placement_scale_drag(self.ctx.doc, asset, point, self._pixel_size())
+                self._drag = ri.placement_scale_drag(self.ctx.doc, asset, _xy(point), self._pixel_size())
             else:
                 self._gesture = self._new_gesture(f"Place {asset}")
-                self._drag = ri.placement_move_drag(self.ctx.doc, asset, point)
+                self._drag = ri.placement_move_drag(self.ctx.doc, asset, _xy(point))
             next(self._drag)
             self._drag_button = button
             event.accept()
@@ -491,11 +484,11 @@ class RigEditorView(QGraphicsView):
             if joint == 0:
                 self.ctx.select(asset, "")
                 self._gesture = self._new_gesture(f"Move {asset}")
-                self._drag = ri.move_drag(self.ctx.doc, asset, point, time, autokey)
+                self._drag = ri.move_drag(self.ctx.doc, asset, _xy(point), time, autokey)
             else:
                 self.ctx.select(asset, character.joints[joint].name)
                 self._gesture = self._new_gesture(f"Rotate {character.joints[joint].name}")
-                self._drag = ri.rotate_drag(self.ctx.doc, asset, joint, point, time, autokey)
+                self._drag = ri.rotate_drag(self.ctx.doc, asset, joint, _xy(point), time, autokey)
             next(self._drag)
             self._drag_button = button
             event.accept()
@@ -508,9 +501,9 @@ class RigEditorView(QGraphicsView):
             character = self.ctx.doc.runtime[asset]
             self.ctx.select(asset, character.joints[joint].name if joint else "")
             self._gesture = self._new_gesture("IK Drag")
-            self._drag = ri.ik_drag(self.ctx.doc, asset, joint, point, time, pose_doc.autokey(self.ctx.doc))
+            self._drag = ri.ik_drag(self.ctx.doc, asset, joint, _xy(point), time, pose_doc.autokey(self.ctx.doc))
             next(self._drag)
-            self._ik = (asset, joint, ri.ik_source(self.ctx.doc, asset, joint, point, time))
+            self._ik = (asset, joint, ri.ik_source(self.ctx.doc, asset, joint, _xy(point), time))
             self._ik_target = point
             self._drag_button = button
             self._ik_following = self.ik_toggle_mode
@@ -538,17 +531,17 @@ class RigEditorView(QGraphicsView):
         doc, time = self.ctx.doc, self.ctx.time
         button = event.button()
         if button == Qt.MouseButton.LeftButton:
-            grab = ri.pivot_at(doc, time, point, ri.PIVOT_GRAB_PX * self._pixel_size())
+            grab = ri.pivot_at(doc, time, _xy(point), ri.PIVOT_GRAB_PX * self._pixel_size())
             if grab is not None:
                 asset, joint = grab
                 character = doc.runtime[asset]
                 self.ctx.select(asset, character.joints[joint].name if joint else "")
                 self._gesture = self._new_gesture(f"Move Pivot of {character.joints[joint].name}")
-                self._drag = ri.pivot_drag(doc, asset, joint, point)
+                self._drag = ri.pivot_drag(doc, asset, joint, _xy(point))
                 next(self._drag)
                 self._drag_button = button
             else:
-                hit = ri.pick_rest(doc, time, point)
+                hit = ri.pick_rest(doc, time, _xy(point))
                 if hit is None:
                     self.ctx.select("", "")
                 else:
@@ -557,7 +550,7 @@ class RigEditorView(QGraphicsView):
             event.accept()
             return
         if button == Qt.MouseButton.RightButton:
-            hit = ri.pick_rest(doc, time, point)
+            hit = ri.pick_rest(doc, time, _xy(point))
             if hit is None and self.character_ids():
                 hit = (self.ctx.selection[0] or self.character_ids()[-1], 0)
             if hit is not None:
@@ -718,7 +711,7 @@ class RigEditorView(QGraphicsView):
 
     def _update_hover(self, point: np.ndarray) -> None:
         try:
-            hit = (ri.pick_rest if self.rig_mode else ri.pick)(self.ctx.doc, self.ctx.time, point)
+            hit = (ri.pick_rest if self.rig_mode else ri.pick)(self.ctx.doc, self.ctx.time, _xy(point))
         except ModuleNotFoundError:
             hit = None
         if hit != self.hover:
@@ -795,14 +788,13 @@ class RigEditorView(QGraphicsView):
         character's, as keying is. True when keys were deleted."""
         if self._drag is not None:
             return False
-        c2d = _c2d()
         asset = self.ctx.selection[0]
-        if not all_characters and asset not in c2d.character_assets(self.ctx.doc):
-            if not bool(self.ctx.doc.parameter(c2d.KEY_ALL_PARAMETER, False)):
+        if not all_characters and asset not in character2d.character_assets(self.ctx.doc):
+            if not bool(self.ctx.doc.parameter(character2d.KEY_ALL_PARAMETER, False)):
                 self._say("Select a character to delete its keys at this frame (Shift+Delete: every character's).")
                 return False
-        command: Command | None = c2d.delete_keys_at(self.ctx.doc, None if all_characters else asset,
-                                                     self.ctx.time)
+        command: Command | None = character2d.delete_keys_at(self.ctx.doc, None if all_characters else asset,
+                                                             self.ctx.time)
         if command is None:
             return False
         self.ctx.push(command)
@@ -816,7 +808,7 @@ class RigEditorView(QGraphicsView):
         self.viewport().update()
 
     # ---------------------------------------------------------------- drawing
-    def drawBackground(self, painter: QPainter, rect: QRectF) -> None:
+    def drawBackground(self, painter: QPainter, rect: QRectF | QRect) -> None:
         painter.fillRect(rect, BACKGROUND)
         doc = self.ctx.doc
         ghosts = ri.onion_frames(self.ctx.frame, self.onion, *doc.frame_range)
@@ -824,11 +816,10 @@ class RigEditorView(QGraphicsView):
         if not ids:
             self._simulation_pending = False
             return
-        c2d, p2d = _c2d(), _painter2d()
         if not self._poses_exact:
             self._poses = None  # read before the worker caught up: read the latest again
         times = [self.ctx.time] + [doc.frame_to_time(frame) for frame, _side, _opacity in ghosts]
-        self._simulation_pending = not c2d.simulation_ready(doc, times)
+        self._simulation_pending = not character2d.simulation_ready(doc, times)
         if self._simulation_pending:
             self.ctx.watch_simulation()
         for frame, side, opacity in ghosts:
@@ -836,10 +827,10 @@ class RigEditorView(QGraphicsView):
             tint = QColor(r, g, b, 170)
             t = doc.frame_to_time(frame)
             for aid in ids:
-                p2d.draw_character(painter, doc.runtime[aid], c2d.evaluate_pose(doc, aid, t, block=False),
-                                   tint=tint, opacity=opacity)
+                painter2d.draw_character(painter, doc.runtime[aid], character2d.evaluate_pose(doc, aid, t, block=False),
+                                         tint=tint, opacity=opacity)
 
-    def drawForeground(self, painter: QPainter, rect: QRectF) -> None:
+    def drawForeground(self, painter: QPainter, rect: QRectF | QRect) -> None:
         self.frames_drawn += 1
         if pose_doc.has_pending(self.ctx.doc, self.ctx.time):
             self._draw_unkeyed_note(painter)
@@ -865,7 +856,7 @@ class RigEditorView(QGraphicsView):
         pose = self.poses().get(asset)
         if joint is None or pose is None:
             return
-        limit = _c2d().joint_limits(self.ctx.doc, asset)[joint]
+        limit = character2d.joint_limits(self.ctx.doc, asset)[joint]
         if limit is None:
             return
         outline = ri.limit_wedge(self.ctx.doc.runtime[asset], pose, joint, limit,
@@ -962,7 +953,7 @@ class RigEditorView(QGraphicsView):
         from qtanimator.core.ik import handout_gradient
 
         gradient = handout_gradient(character, pose, joint, local, self._ik_target)
-        scale = float(_c2d().ik_setting(doc, "ik.gradient_arrow_scale"))
+        scale = float(character2d.ik_setting(doc, "ik.gradient_arrow_scale"))
         for start, end in ri.gradient_arrows(character, pose, gradient, scale):
             self._arrow(painter, start, end - start, QColor(255, 220, 0))
         self._dot(painter, pose.to_world(joint, local), 12.0, QColor(255, 0, 0))
@@ -1133,7 +1124,7 @@ class RigEditor(QWidget):
 # ---------------------------------------------------------------------- openers
 def open_characters(window: MainWindow, path: Path) -> None:
     """Add the characters of an SVG file or folder (FormatError leaves the document as is)."""
-    command = _c2d().add_characters_command(window.doc, path, new_project_range=True)
+    command = character2d.add_characters_command(window.doc, path, new_project_range=True)
     window.ctx.push(command)
     editor = getattr(window, "rig_editor", None)
     if editor is not None:
@@ -1142,11 +1133,6 @@ def open_characters(window: MainWindow, path: Path) -> None:
 
 
 def install(window: MainWindow) -> None:
-    try:
-        _c2d()
-        _painter2d()
-    except ModuleNotFoundError:
-        return  # the 2D engine is not there yet
     editor = RigEditor(window.ctx)
     window.rig_editor = editor  # type: ignore[attr-defined]
     window.add_central(editor, "2D Rig")
@@ -1176,10 +1162,17 @@ def _restore_editor_settings(editor: RigEditor) -> None:
     from qtanimator.ui.main_window import settings
 
     s = settings()
+
+    def stored(key: str, default: int) -> int:
+        value = s.value(key, default)
+        if not isinstance(value, (int, float, str)):
+            raise TypeError(f"{key}: {value!r} is no number")
+        return int(value)
+
     try:
-        editor.before_box.setValue(int(s.value("rigEditor/onionBefore", editor.before_box.value())))
-        editor.after_box.setValue(int(s.value("rigEditor/onionAfter", editor.after_box.value())))
-        editor.step_box.setValue(int(s.value("rigEditor/onionStep", editor.step_box.value())))
+        editor.before_box.setValue(stored("rigEditor/onionBefore", editor.before_box.value()))
+        editor.after_box.setValue(stored("rigEditor/onionAfter", editor.after_box.value()))
+        editor.step_box.setValue(stored("rigEditor/onionStep", editor.step_box.value()))
     except (TypeError, ValueError):
         pass
 

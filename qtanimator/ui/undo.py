@@ -18,11 +18,12 @@ class DocumentUndoCommand(QUndoCommand):
     ``redo`` once, which then does nothing; later redos do the command again.
     """
 
-    def __init__(self, doc: Document, command: Command, done: bool = False) -> None:
+    def __init__(self, doc: Document, command: Command, done: bool = False, mergeable: bool = True) -> None:
         super().__init__(command.text)
         self.doc = doc
         self.command = command
         self._skip_redo = done
+        self._mergeable = mergeable
 
     def redo(self) -> None:
         if self._skip_redo:
@@ -36,7 +37,7 @@ class DocumentUndoCommand(QUndoCommand):
             self.command.undo(self.doc)
 
     def id(self) -> int:
-        return _MERGE_ID if self.command.gesture is not None else -1
+        return _MERGE_ID if self._mergeable and self.command.gesture is not None else -1
 
     def mergeWith(self, other: QUndoCommand) -> bool:
         if not isinstance(other, DocumentUndoCommand):
@@ -50,29 +51,34 @@ class DocumentUndoCommand(QUndoCommand):
 
 
 def push_command(stack: QUndoStack, doc: Document, command: Command) -> None:
-    """Do ``command`` and record it (merging with the previous one of the same gesture).
+    """Do ``command`` and record it (merging with the previous one of the same gesture), as
+    the Qt-free :meth:`UndoStack.push <qtanimator.document.commands.UndoStack.push>` does.
 
-    A command that changes nothing is done but not recorded (Qt drops obsolete commands).
+    A command that changes nothing is done here and pushed obsolete: Qt then never does it
+    again and never keeps it, but the push still drops the redo history and lets the top
+    command of the same gesture merge it (a drag back to where it began).
     """
-    if command.is_noop() and not _continues_gesture(stack, command):
+    if command.is_noop():
         with doc.batch():
             command.do(doc)
+        _push_obsolete(stack, doc, command, mergeable=True)
         return
     stack.push(DocumentUndoCommand(doc, command))
 
 
 def record_command(stack: QUndoStack, doc: Document, command: Command) -> None:
-    """Record a command that is already done (a committed gesture) as one undo step."""
-    if not command.is_noop():
-        stack.push(DocumentUndoCommand(doc, command, done=True))
+    """Record a command that is already done (a committed gesture) as one undo step; one
+    that changes nothing is not recorded but, like any record, drops the redo history."""
+    if command.is_noop():
+        _push_obsolete(stack, doc, command, mergeable=False)
+        return
+    stack.push(DocumentUndoCommand(doc, command, done=True))
 
 
-def _continues_gesture(stack: QUndoStack, command: Command) -> bool:
-    # QUndoStack does not merge into the command a save marked clean.
-    if command.gesture is None or stack.index() == 0 or stack.index() == stack.cleanIndex():
-        return False
-    top = stack.command(stack.index() - 1)
-    return isinstance(top, DocumentUndoCommand) and top.command.gesture == command.gesture
+def _push_obsolete(stack: QUndoStack, doc: Document, command: Command, mergeable: bool) -> None:
+    wrapper = DocumentUndoCommand(doc, command, done=True, mergeable=mergeable)
+    wrapper.setObsolete(True)  # QUndoStack.push neither does nor keeps it
+    stack.push(wrapper)
 
 
 def drop_gesture(stack: QUndoStack, doc: Document, gesture: object) -> bool:

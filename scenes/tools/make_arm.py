@@ -225,8 +225,7 @@ def write(out: Path) -> list[Path]:
         p = out / name
         p.write_text(text, encoding="utf-8", newline="\n")
         paths.append(p)
-    doc = Document()
-    doc.parameters.update({"fps": 60.0, "frame_start": 0, "frame_end": 240})
+    doc = Document(parameters={"fps": 60.0, "frame_start": 0, "frame_end": 240})
     add_character3d_command(doc, out / "arm.skel", out / "arm.skin", out / "arm_wave.anim", asset_id="arm").do(doc)
     save_document(doc, out / "arm3d.qtanim")
     paths.append(out / "arm3d.qtanim")

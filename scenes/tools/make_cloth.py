@@ -37,8 +37,7 @@ def flag_params() -> ClothParams:
 
 
 def build() -> Document:
-    doc = Document()
-    doc.parameters.update({"fps": 60.0, "frame_start": 0, "frame_end": 240})
+    doc = Document(parameters={"fps": 60.0, "frame_start": 0, "frame_end": 240})
     add_cloth_command(doc, flag_params(), asset_id="flag").do(doc)
     return doc
 

@@ -217,8 +217,7 @@ def pencil_project(out: Path) -> None:
     from qtanimator.document import Document, SetChannels, save_document
     from qtanimator.document.character2d import add_characters_command, angle_channel_id, position_channel_ids
 
-    doc = Document()
-    doc.parameters.update({"fps": 60.0, "frame_start": 0, "frame_end": 240})
+    doc = Document(parameters={"fps": 60.0, "frame_start": 0, "frame_end": 240})
     add_characters_command(doc, out / "pencil.svg").do(doc)
     # A loop-the-loop signature: offsets from the rest position of the tip, every 0.4 s.
     path_xy = [(0, 0), (60, -40), (120, 10), (90, 60), (40, 20), (110, -30), (190, -10), (230, 40),
@@ -240,8 +239,7 @@ def flappy_project(out: Path) -> None:
     from qtanimator.document import Document, SetChannels, SetParameter, save_document
     from qtanimator.document.character2d import add_characters_command, angle_channel_id, position_channel_ids
 
-    doc = Document()
-    doc.parameters.update({"fps": 60.0, "frame_start": 0, "frame_end": 240})
+    doc = Document(parameters={"fps": 60.0, "frame_start": 0, "frame_end": 240})
     add_characters_command(doc, out / "flappy.svg").do(doc)
     cycle = Extrapolation.CYCLE
     tracks = {

@@ -211,8 +211,7 @@ def build_project(svg: Path):  # type: ignore[no-untyped-def]
     from qtanimator.document import Document, SetChannels
     from qtanimator.document.character2d import add_characters_command
 
-    doc = Document()
-    doc.parameters.update({"fps": FPS, "frame_start": 0, "frame_end": int(2 * PERIOD * FPS)})
+    doc = Document(parameters={"fps": FPS, "frame_start": 0, "frame_end": int(2 * PERIOD * FPS)})
     add_characters_command(doc, svg).do(doc)
     changes = {}
     for cid, keys in KEYS.items():

@@ -3,12 +3,14 @@
 from __future__ import annotations
 
 import numpy as np
-from hypothesis import given, settings
+from hypothesis import given
 from hypothesis import strategies as st
+from hypothesis_profiles import thorough
 
 from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key
 
-SETTINGS = settings(max_examples=60, deadline=None)
+# 60 examples locally, 200 with fixed seeds in CI (tests/hypothesis_profiles.py)
+SETTINGS = thorough(deadline=None)
 
 rules = st.one_of(st.sampled_from(["flat", "linear", "smooth", "clamped", "centripetal", "chordal", "tcb"]),
                   st.floats(-20, 20, allow_nan=False))

@@ -5,7 +5,6 @@ explicit integrator's automatic substeps follow its stability bound."""
 
 from __future__ import annotations
 
-import ast
 import json
 import math
 from pathlib import Path
@@ -28,14 +27,12 @@ FPS = (24, 30, 60)
 
 
 def panel_float_ranges() -> dict[str, tuple[float, float, float, int]]:
-    """The cloth panel's field ranges (ui/cloth_panel.py FLOAT_RANGES), read from its source
-    so that this Qt-free test follows the panel without importing Qt."""
-    tree = ast.parse((REPO / "qtanimator" / "ui" / "cloth_panel.py").read_text(encoding="utf-8"))
-    for node in tree.body:
-        target = node.target if isinstance(node, ast.AnnAssign) else None
-        if isinstance(target, ast.Name) and target.id == "FLOAT_RANGES" and node.value is not None:
-            return dict(ast.literal_eval(node.value))
-    raise AssertionError("FLOAT_RANGES not found in ui/cloth_panel.py")
+    """The cloth panel's field ranges: the parameter schema's (document/parameters.py CLOTH,
+    Qt-free), which the panel's fields are built from."""
+    from qtanimator.document.parameters import CLOTH
+
+    return {k: (float(p.minimum), float(p.maximum), float(p.step), int(p.decimals))  # type: ignore[arg-type]
+            for k, p in CLOTH.items() if p.kind == "float"}
 
 
 RANGES = panel_float_ranges()

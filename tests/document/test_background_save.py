@@ -12,6 +12,7 @@ from collections.abc import Iterable
 from pathlib import Path
 
 import pytest
+from docfix import set_channels, set_parameters
 
 from qtanimator.core.channel import Channel, Key
 from qtanimator.document import AddAsset, Asset, Document, InsertKey, SetAssetProperty, SetParameter, UndoStack
@@ -155,7 +156,7 @@ def test_a_failed_write_is_reported_on_the_job(tmp_path, saver):
     job = saver.submit(to_project_data(doc), tmp_path / "a.qtanim")
     assert not job.wait(WAIT)
     assert isinstance(job.error, OSError) and not job.written
-    doc.parameters["bad"] = object()
+    set_parameters(doc, {"bad": object()})
     saver.write_file = write_chunks_atomic
     job = saver.submit(to_project_data(doc), tmp_path / "a.qtanim")
     assert not job.wait(WAIT)
@@ -175,7 +176,7 @@ def test_same_snapshot_compares_channels_by_identity_and_the_rest_by_value():
     assert same_snapshot(a, to_project_data(doc))
     assert a.channels is not doc.channels and a.parameters["cloth.wind"] is not doc.parameters["cloth.wind"]
     # An equal but new channel object counts as a change (a snapshot never compares keys).
-    doc.channels["lamp/j0/rz"] = Channel(doc.channels["lamp/j0/rz"].keys)
+    set_channels(doc, {"lamp/j0/rz": Channel(doc.channels["lamp/j0/rz"].keys)})
     assert not same_snapshot(a, to_project_data(doc))
     b = to_project_data(doc)
     stack.push(SetParameter(doc, "fps", 30))

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from docfix import set_parameters
 
 from qtanimator.core.channel import Key
 from qtanimator.core.ik import ik_error
@@ -66,7 +67,7 @@ def test_a_new_project_of_svg_characters_spans_the_cmu_300_frames() -> None:
     stack.undo()
     assert doc.frame_range == (0, 240) and not doc.assets
     edited = Document()
-    edited.parameters["frame_end"] = 90
+    set_parameters(edited, {"frame_end": 90})
     add_characters_command(edited, PIP, new_project_range=True).do(edited)
     assert edited.frame_range == (0, 90)  # a range the user set is kept
     assert make()[0].frame_range == (0, 240)  # scripts (scene generators) keep their own range

@@ -9,6 +9,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from docfix import set_parameters
 
 from qtanimator.core.cloth import Cloth, ClothParams
 from qtanimator.document import Document
@@ -38,7 +39,7 @@ def _cape_params() -> ClothParams:
 
 def _doc(frames: int = 600, integrator: str = "implicit") -> Document:
     doc = Document()
-    doc.parameters.update({"fps": 60.0, "frame_start": 0, "frame_end": frames})
+    set_parameters(doc, fps=60.0, frame_start=0, frame_end=frames)
     w = SCENES / "walker"
     add_character3d_command(doc, w / "walker.skel", w / "walker.skin", w / "walker_walk.anim",
                             asset_id="walker").do(doc)

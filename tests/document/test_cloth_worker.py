@@ -272,3 +272,27 @@ def test_live_edits_never_wait_for_a_step_and_keep_their_order() -> None:
         assert live.cloths == {} and live.frames() == {}
     finally:
         live.close()
+
+
+def test_live_cloth_with_invalid_parameters_is_reported_not_replaced_by_defaults() -> None:
+    """A cloth whose stored parameters cannot make a cloth gets no live simulation with made-up
+    (default) parameters: the problem is in ``errors`` (the Cloth dock shows it)."""
+    from qtanimator.document.commands import SetAssetProperty
+
+    doc, stack = make_doc(FLAG.replace(gravity=2.0))
+    live = LiveCloths()
+    try:
+        live.sync(doc)
+        live.step()
+        assert live.cloths["flag"].params.gravity == 2.0 and "flag" not in live.errors
+        stack.push(SetAssetProperty(doc, "flag", "rows", -3))
+        live.sync(doc)
+        live.step()
+        assert "flag" not in live.cloths
+        assert "flag" in live.errors and "rows" in live.errors["flag"]
+        stack.undo()
+        live.sync(doc)
+        live.step()
+        assert live.cloths["flag"].params.gravity == 2.0 and "flag" not in live.errors
+    finally:
+        live.close()

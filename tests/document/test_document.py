@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from docfix import set_parameters
+
 from qtanimator.core.channel import Channel, Key
 from qtanimator.document import Asset, Document, DocumentChange
 from qtanimator.document.document import PROJECT_DEFAULTS
@@ -12,7 +14,7 @@ def test_defaults_and_time_conversion():
     assert doc.parameters == PROJECT_DEFAULTS and doc.parameters is not PROJECT_DEFAULTS
     assert doc.fps == 60.0 and doc.frame_range == (0, 240)
     assert doc.frame_to_time(90) == 1.5 and doc.time_to_frame(1.5) == 90
-    doc.parameters["fps"] = 24
+    set_parameters(doc, {"fps": 24})
     assert doc.frame_to_time(12) == 0.5
     assert doc.parameter("missing", 3) == 3
 
@@ -47,7 +49,7 @@ def test_notification_and_reset():
         ({"cloth.wind"}, set(), {}), ({"cloth.wind"}, set(), {}), (set(), {"a"}, {}), (set(), set(), {"a//x": 0.5})]
     assert seen[-1].time_from == 0.5 and "cloth.wind" not in doc.parameters
     other = Document()
-    other.parameters["fps"] = 30
+    set_parameters(other, {"fps": 30})
     doc.replace_all(other)
     assert seen[-1].reset and doc.fps == 30 and doc.assets == {} and doc.runtime == {}
     doc.unsubscribe(seen.append)
@@ -65,3 +67,28 @@ def test_state_is_a_deep_copy():
     assert doc.state() != state
     assert doc.assets["a"].properties["color"] == [1, 0, 0]
     assert "runtime" not in doc.state()
+
+
+def test_channels_and_parameters_are_read_only_views():
+    import copy
+    import pickle
+
+    import pytest
+
+    doc = Document(channels={"a//x": Channel([Key(0, 1)])}, parameters={"fps": 24})
+    assert doc.fps == 24 and doc.frame_range == (0, 240)  # the defaults fill in the rest
+    with pytest.raises(TypeError):
+        doc.channels["a//y"] = Channel()  # type: ignore[index]
+    with pytest.raises(TypeError):
+        doc.parameters["fps"] = 30  # type: ignore[index]
+    with pytest.raises(AttributeError):
+        doc.channels = {}  # type: ignore[misc]
+    view = doc.channels
+    doc.apply_channel("a//y", Channel([Key(0, 2)]))
+    assert "a//y" in view and dict(doc.channels).keys() == {"a//x", "a//y"}  # live, not a copy
+    for back in (pickle.loads(pickle.dumps(doc)), copy.deepcopy(doc)):
+        assert back.state() == doc.state()
+        back.apply_parameter("fps", 30)
+        assert back.fps == 30 and doc.fps == 24
+    shallow = copy.copy(doc)
+    assert shallow.channels == doc.channels and shallow.state() == doc.state()

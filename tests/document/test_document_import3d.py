@@ -6,6 +6,7 @@ import shutil
 
 import numpy as np
 import pytest
+from docfix import set_parameters
 
 from qtanimator.core.skeleton import rotation_matrices
 from qtanimator.document import Document, UndoStack, open_document, save_document
@@ -190,7 +191,7 @@ def test_bad_files_are_format_errors_and_change_nothing(tmp_path):
 def test_export_gltf_round_trip(shared_data, tmp_path):
     doc, _stack, result, _ = _imported(shared_data / "cse169" / "wasp_walk" / "wasp.skel")
     aid = result.asset_id
-    doc.parameters["frame_end"] = 60
+    set_parameters(doc, {"frame_end": 60})
     out = tmp_path / "wasp.glb"
     export, warned = export_gltf(doc, aid, out)
     assert warned == [] or all("influences" in w for w in warned)

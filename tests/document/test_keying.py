@@ -8,6 +8,7 @@ import json
 from pathlib import Path
 
 import pytest
+from docfix import set_channels
 
 from qtanimator.core.channel import Channel, Key, Tangent
 from qtanimator.document import Document, UndoStack
@@ -40,9 +41,9 @@ def frames(ch: Channel) -> list[float]:
 
 def make_doc() -> tuple[Document, UndoStack]:
     doc = Document()
-    doc.channels[A] = Channel([Key(f(0), 0.0), Key(f(10), 1.0, Tangent.FLAT, Tangent.LINEAR), Key(f(14), 2.0),
-                               Key(f(34), 3.0), Key(f(40), 4.0)])
-    doc.channels[B] = Channel([Key(f(12), 10.0), Key(f(20), 20.0)])
+    set_channels(doc, {A: Channel([Key(f(0), 0.0), Key(f(10), 1.0, Tangent.FLAT, Tangent.LINEAR), Key(f(14), 2.0),
+                               Key(f(34), 3.0), Key(f(40), 4.0)])})
+    set_channels(doc, {B: Channel([Key(f(12), 10.0), Key(f(20), 20.0)])})
     return doc, UndoStack(doc)
 
 
@@ -127,7 +128,7 @@ def test_bad_paste_mode_and_scale_factor_are_refused():
 # --------------------------------------------------------------------- retime
 def test_retime_snaps_the_offset_to_whole_frames():
     doc, stack = make_doc()
-    doc.channels[B] = Channel([Key(f(10.5), 1.0), Key(f(20), 2.0)])  # a key between frames
+    set_channels(doc, {B: Channel([Key(f(10.5), 1.0), Key(f(20), 2.0)])})  # a key between frames
     edit = retime_keys_command(doc, {A: [1, 2], B: [0]}, f(2.4), snap_fps=FPS)
     stack.push(edit.command)
     assert frames(doc.channels[A]) == [0, 12, 16, 34, 40]
@@ -175,8 +176,8 @@ def test_a_drag_of_many_retimes_is_one_undo_step_and_the_last_wins(tmp_path):
 # ---------------------------------------------------------------------- scale
 def test_scale_about_a_pivot_with_snapping(tmp_path):
     doc, stack = make_doc()
-    doc.channels[A] = Channel([Key(f(10), 1.0), Key(f(20), 2.0, Tangent.FIXED, Tangent.FIXED, 4.5, 3.0),
-                               Key(f(31), 3.0), Key(f(50), 5.0)])
+    set_channels(doc, {A: Channel([Key(f(10), 1.0), Key(f(20), 2.0, Tangent.FIXED, Tangent.FIXED, 4.5, 3.0),
+                               Key(f(31), 3.0), Key(f(50), 5.0)])})
     before = saved(doc, tmp_path)
     # Pivot 12, factor 1.5: 10 → 12 − 2·1.5 = 9, 20 → 12 + 8·1.5 = 24, 31 → 12 + 19·1.5 =
     # 40.5 → 41 (halves round up); 50 is not selected.
@@ -197,7 +198,7 @@ def test_scale_about_a_pivot_with_snapping(tmp_path):
 
 def test_scaled_keys_snapped_onto_one_frame_keep_the_nearest():
     doc = Document()
-    doc.channels[A] = Channel([Key(f(10), 1.0), Key(f(11), 2.0), Key(f(12), 3.0), Key(f(1), 9.0)])
+    set_channels(doc, {A: Channel([Key(f(10), 1.0), Key(f(11), 2.0), Key(f(12), 3.0), Key(f(1), 9.0)])})
     # About frame 0 by 0.1: 10 → 1.0, 11 → 1.1, 12 → 1.2, all on frame 1; 10 lands exactly
     # there and wins; the unselected key at frame 1 gives way to it.
     edit = scale_keys_command(doc, {A: [1, 2, 3]}, 0.0, 0.1, snap_fps=FPS)

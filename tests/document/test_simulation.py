@@ -58,13 +58,12 @@ def demo(demo_source: Document) -> Callable[[], Document]:
     their keys and parameters; characters and channels are shared (both are read-only)."""
 
     def make() -> Document:
-        doc = Document()
-        doc.parameters = dict(demo_source.parameters)
-        for aid in ("pip", "pendulum_clock"):
+        aids = ("pip", "pendulum_clock")
+        doc = Document(parameters=demo_source.parameters,
+                       channels={cid: ch for cid, ch in demo_source.channels.items() if cid.split("/", 1)[0] in aids})
+        for aid in aids:
             doc.assets[aid] = demo_source.assets[aid].copy()
             doc.runtime[aid] = demo_source.runtime[aid]
-        doc.channels = {cid: ch for cid, ch in demo_source.channels.items()
-                        if cid.split("/", 1)[0] in doc.assets}
         return doc
 
     return make

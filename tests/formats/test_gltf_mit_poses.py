@@ -23,6 +23,7 @@ from pathlib import Path
 import gltf_spec
 import gltf_validator
 import numpy as np
+from docfix import set_parameters
 
 from qtanimator.document import Document, UndoStack
 from qtanimator.document.character3d import character, set_dofs_command, skinned_mesh
@@ -55,7 +56,7 @@ def test_model1_random_poses_match_independent_skinning(shared_data: Path, tmp_p
                 lo, hi = max(dof.min, -SPREAD), min(dof.max, SPREAD)
                 values[(j, a)] = float(rng.uniform(lo, hi)) if lo < hi else dof.clamp(0.0)
         stack.push(set_dofs_command(doc, aid, values, t))
-    doc.parameters["frame_start"], doc.parameters["frame_end"] = 0, (POSES - 1) * STEP
+    set_parameters(doc, {"frame_start": 0, "frame_end": (POSES - 1) * STEP})
 
     out = tmp_path / "model1_poses.glb"
     result, _messages = export_gltf(doc, aid, out)

@@ -24,6 +24,7 @@ import gltf_gen
 import gltf_validator
 import numpy as np
 import pytest
+from docfix import set_parameters
 
 from qtanimator.core.channel import Channel, Interpolation, Key
 from qtanimator.core.skinning import Skin, skin_positions
@@ -340,7 +341,7 @@ def test_course_character_exports_and_validates(shared_data: Path, tmp_path: Pat
     """wasp.skel (+ .skin, .anim): Euler joints and the root translation are sampled at the
     document's fps over its frame range (time 0 at its start); the samples come back exactly."""
     a, _sa, aid = _import(shared_data / "cse169" / "wasp_walk" / "wasp.skel")
-    a.parameters["frame_start"], a.parameters["frame_end"] = 6, 120
+    set_parameters(a, {"frame_start": 6, "frame_end": 120})
     result, messages = export_gltf(a, aid, tmp_path / "wasp.glb")
     assert messages == []
     _validated(tmp_path / "wasp.glb")
@@ -359,7 +360,7 @@ def test_mit_model_keeps_every_influence(shared_data: Path, tmp_path: Path) -> N
     (which glTF requires; the export says how far that moves the mesh)."""
     a, sa, aid = _import(shared_data / "mit6837" / "Model1.skel")
     sa.push(set_dofs_command(a, aid, {(j, "x"): 0.6 for j in range(1, 10)}, 0.5))
-    a.parameters["frame_end"] = 30
+    set_parameters(a, {"frame_end": 30})
     result, messages = export_gltf(a, aid, tmp_path / "model1.glb")
     assert len(messages) == 1 and "do not sum to 1" in messages[0]
     _validated(tmp_path / "model1.glb")

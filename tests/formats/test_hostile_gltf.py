@@ -170,9 +170,9 @@ def test_a_skin_within_the_joint_limit_still_opens(tmp_path: Path) -> None:
 
 
 def test_too_many_vertices_are_refused(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
-    from qtanimator.formats import gltf
+    from qtanimator.formats.gltf import reader
 
-    monkeypatch.setattr(gltf, "MAX_VERTICES", 2)  # the limit is counted over every primitive
+    monkeypatch.setattr(reader, "MAX_VERTICES", 2)  # the limit is counted over every primitive
     path = gltf_with_buffer(tmp_path, "tri.bin", 12)
     (tmp_path / "tri.bin").write_bytes(struct.pack("<3f", 1.0, 2.0, 3.0))
     doc = json.loads(path.read_text())

@@ -9,6 +9,7 @@ import stat
 from pathlib import Path
 
 import pytest
+from docfix import set_channels, set_parameters
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from needs import missing
@@ -97,10 +98,10 @@ def test_a_failed_save_leaves_the_old_file(tmp_path):
     path = tmp_path / "scene.qtanim"
     save_document(doc, path)
     old = path.read_bytes()
-    doc.parameters["bad"] = float("nan")
+    set_parameters(doc, {"bad": float("nan")})
     with pytest.raises(ValueError, match="JSON cannot store"):
         save_document(doc, path)
-    doc.parameters["bad"] = object()
+    set_parameters(doc, {"bad": object()})
     with pytest.raises(ValueError, match="JSON cannot store"):
         save_document(doc, path)
     assert path.read_bytes() == old
@@ -112,7 +113,7 @@ def test_a_save_that_fails_while_writing_leaves_the_old_file(tmp_path, monkeypat
     path = tmp_path / "scene.qtanim"
     save_document(doc, path)
     old = path.read_bytes()
-    doc.parameters["fps"] = 30
+    set_parameters(doc, {"fps": 30})
 
     def broken_replace(src: str, dst: str) -> None:
         raise OSError(28, "No space left on device")
@@ -350,7 +351,7 @@ def test_view_state_round_trips_apart_from_authored_state(tmp_path):
 def test_channels_are_written_as_columns(tmp_path):
     doc = make_doc(tmp_path)
     long = Channel([Key(i / 24.0, (-1.0) ** i * i / 7.0) for i in range(2 * NUMBERS_PER_LINE + 3)], "cycle")
-    doc.channels["lamp/bulb/rx"] = long
+    set_channels(doc, {"lamp/bulb/rx": long})
     save_document(doc, tmp_path / "scene.qtanim")
     text = (tmp_path / "scene.qtanim").read_text(encoding="utf-8")
     channels = json.loads(text)["channels"]

@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from docfix import set_parameters
 
 from qtanimator.document import Document, UndoStack
 from qtanimator.document.character2d import (
@@ -184,7 +185,7 @@ def _posed(shared_data: Path, name: str, placed: bool) -> tuple[Document, str]:
     stack.push(add_characters_command(doc, shared_data / "cmu-animator" / "scenes" / name))
     aid = next(iter(doc.assets))
     ch = character(doc, aid)
-    doc.parameters["frame_start"], doc.parameters["frame_end"] = 5, 65
+    set_parameters(doc, {"frame_start": 5, "frame_end": 65})
     rng = np.random.default_rng(7)
     for frame in (5, 20, 40, 65):
         t = doc.frame_to_time(frame)

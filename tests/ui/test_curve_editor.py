@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 from curve_helpers import drag, hover, key_pos, view_pos, viewport_pos
+from docfix import set_channels
 from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtWidgets import QApplication
 
@@ -19,12 +20,12 @@ def make_doc() -> Document:
     """Values in the document's units everywhere (no rotation: those show in degrees; see
     test_curve_editor_animator.py)."""
     doc = Document()
-    doc.channels["hero//x"] = Channel([Key(0.0, 0.0), Key(0.5, 2.0), Key(1.0, 1.0, "flat", "flat")],
-                                      post="cycle")
-    doc.channels["hero/arm/bend"] = Channel(
-        [Key.make(0.25, -1.0, "linear", "linear"), Key.make(1.25, 1.5, 0.0, 3.0)], pre="linear", post="bounce")
-    doc.channels["hero//y"] = Channel([Key(0.1, 0.5), Key(0.6, -0.5), Key(0.9, 0.2)],
-                                      pre="cycle_offset", post="cycle_offset")
+    set_channels(doc, {"hero//x": Channel([Key(0.0, 0.0), Key(0.5, 2.0), Key(1.0, 1.0, "flat", "flat")],
+                                      post="cycle")})
+    set_channels(doc, {"hero/arm/bend": Channel(
+        [Key.make(0.25, -1.0, "linear", "linear"), Key.make(1.25, 1.5, 0.0, 3.0)], pre="linear", post="bounce")})
+    set_channels(doc, {"hero//y": Channel([Key(0.1, 0.5), Key(0.6, -0.5), Key(0.9, 0.2)],
+                                      pre="cycle_offset", post="cycle_offset")})
     return doc
 
 
@@ -205,8 +206,8 @@ def test_ctrl_click_inserts_key_on_curve_and_delete_removes(qtbot, editor):
 def test_moving_several_keys_keeps_rules_and_slopes(qtbot, editor):
     ed = editor
     doc = ed.ctx.doc
-    doc.channels["hero//y"] = Channel([Key.make(0.1, 0.5, "flat", 2.0), Key.make(0.6, -0.5, -1.5, "clamped"),
-                                       Key.make(0.9, 0.2, "linear", "smooth", broken=True)])
+    set_channels(doc, {"hero//y": Channel([Key.make(0.1, 0.5, "flat", 2.0), Key.make(0.6, -0.5, -1.5, "clamped"),
+                                       Key.make(0.9, 0.2, "linear", "smooth", broken=True)])})
     ed.view.refresh_all()
     old = doc.channels["hero//y"]
     drag(qtbot, ed, view_pos(ed, 3, 0.8), view_pos(ed, 58, -0.8))  # box: all three y keys
@@ -435,8 +436,8 @@ def test_install_adds_the_dock(qtbot):
 def test_ctrl_drag_scales_keys_in_time_keeping_handles(qtbot, editor):
     ed = editor
     doc = ed.ctx.doc
-    doc.channels["hero//y"] = Channel([Key.make(0.1, 0.5, "flat", 2.0), Key.make(0.6, -0.5, -1.5, "clamped"),
-                                       Key.make(0.9, 0.2, "linear", "smooth", broken=True)])
+    set_channels(doc, {"hero//y": Channel([Key.make(0.1, 0.5, "flat", 2.0), Key.make(0.6, -0.5, -1.5, "clamped"),
+                                       Key.make(0.9, 0.2, "linear", "smooth", broken=True)])})
     ed.view.refresh_all()
     old = doc.channels["hero//y"]
     ed.ctx.set_frame(6.0)  # the pivot: the first key
@@ -482,7 +483,7 @@ def test_new_channels_appear_and_reset_rebuilds(qtbot, editor):
     assert "wasp/knee_01_l/rz" not in ed.tree.channel_ids()
     assert ed.view.selected_keys() == {}
     fresh = Document()
-    fresh.channels["bob//y"] = Channel([Key(0, 1.0)])
+    set_channels(fresh, {"bob//y": Channel([Key(0, 1.0)])})
     ed.ctx.replace_document(fresh)
     assert ed.tree.channel_ids() == ["bob//y"]
     assert ed.view.visible == ["bob//y"]
@@ -566,7 +567,7 @@ def test_channel_tree_keeps_expansion_and_scroll_when_channels_change(qtbot, edi
     ed = editor
     tree = ed.tree
     for j in range(12):  # enough rows to scroll
-        ed.ctx.doc.channels[f"hero/bone{j:02d}/angle"] = Channel([Key(0.0, 0.0), Key(1.0, 0.1 * j)])
+        set_channels(ed.ctx.doc, {f"hero/bone{j:02d}/angle": Channel([Key(0.0, 0.0), Key(1.0, 0.1 * j)])})
     ed.ctx.replace_document(ed.ctx.doc)
     ed.splitter.setSizes([200, 800])
     ed.resize(1000, 260)

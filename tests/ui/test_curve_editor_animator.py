@@ -12,6 +12,7 @@ import math
 import numpy as np
 import pytest
 from curve_helpers import drag, hover, key_pos, view_pos, viewport_pos
+from docfix import set_channels
 from PySide6.QtCore import QPoint, QPointF, Qt
 from PySide6.QtGui import QPainterPath
 from PySide6.QtWidgets import QApplication, QMenu
@@ -29,8 +30,8 @@ X = "hero//x"              # a position: its own units
 
 def make_doc() -> Document:
     doc = Document()
-    doc.channels[ANGLE] = Channel([Key(0.25, -0.9), Key(0.75, 0.6), Key(1.25, 0.2, "flat", "flat")])
-    doc.channels[X] = Channel([Key(0.0, 0.0), Key(0.5, 40.0), Key(1.0, 20.0)])
+    set_channels(doc, {ANGLE: Channel([Key(0.25, -0.9), Key(0.75, 0.6), Key(1.25, 0.2, "flat", "flat")])})
+    set_channels(doc, {X: Channel([Key(0.0, 0.0), Key(0.5, 40.0), Key(1.0, 20.0)])})
     return doc
 
 
@@ -385,7 +386,7 @@ def test_weighted_spans_are_drawn_exactly_and_per_column(qtbot, editor):
     ch = Channel([Key(0.0, 0.0, "flat", "flat", out_weight=0.45), Key(0.5, 1.0, in_weight=0.05, out_weight=0.2),
                   Key(1.0, -0.5, "linear", "linear", in_weight=0.1), Key(1.5, 0.3)])
     assert ch.is_weighted
-    doc.channels[ANGLE] = ch
+    set_channels(doc, {ANGLE: ch})
     ed.view.refresh_all()
     _check_drawn(ed, ANGLE)
     # Per-column drawing (a dense view) stays within its tolerance of the curve.

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from docfix import set_channels
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -30,7 +31,7 @@ def channels(draw):
 @given(channels(), st.data())
 def test_move_keeps_rules_and_slopes_and_undo_is_exact(ch, data):
     doc = Document()
-    doc.channels["a/j/rx"] = ch
+    set_channels(doc, {"a/j/rx": ch})
     idx = data.draw(st.lists(st.integers(0, len(ch.keys) - 1), min_size=1, unique=True))
     dt = data.draw(st.integers(-30, 30)) / 60.0
     dv = data.draw(st.floats(-3, 3))
@@ -55,7 +56,7 @@ def test_move_keeps_rules_and_slopes_and_undo_is_exact(ch, data):
 def test_time_scale_divides_fixed_slopes_and_merges_in_one_gesture():
     ch = Channel([Key.make(0.0, 0.0, "flat", 2.0), Key.make(1.0, 1.0, -4.0, "smooth")])
     doc = Document()
-    doc.channels["c//x"] = ch
+    set_channels(doc, {"c//x": ch})
     stack = UndoStack(doc)
     for f in (1.5, 2.0, 0.5):
         stack.push(MoveKeys({"c//x": ch}, {"c//x": [0, 1]}, 0.0, 0.0, gesture="s", time_scale=(0.0, f)))
@@ -74,7 +75,7 @@ def test_time_scale_divides_fixed_slopes_and_merges_in_one_gesture():
 def test_set_key_slopes_and_break_unify():
     doc = Document()
     ch = Channel([Key(0, 0), Key(1, 2), Key(2, 0, "linear", "linear")])
-    doc.channels["c//x"] = ch
+    set_channels(doc, {"c//x": ch})
     stack = UndoStack(doc)
     stack.push(SetKeySlopes(doc, "c//x", 1, in_slope=1.5, gesture="h"))
     stack.push(SetKeySlopes(doc, "c//x", 1, in_slope=2.5, out_slope=2.5, gesture="h"))

@@ -7,7 +7,9 @@ import math
 
 import pytest
 from curve_helpers import hover, key_pos
-from PySide6.QtCore import QPoint, QPointF, Qt
+from docfix import set_channels
+from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
+from PySide6.QtGui import QCursor, QMouseEvent
 from PySide6.QtTest import QTest
 from PySide6.QtWidgets import QApplication, QWidget
 
@@ -25,8 +27,8 @@ def make_doc() -> Document:
     doc = Document()
     for j, joint in enumerate(("arm", "leg", "head")):
         for d, dof in enumerate(("rx", "ry", "rz")):
-            doc.channels[f"hero/{joint}/{dof}"] = Channel(
-                [Key(0.25 * k, 0.3 * ((k + j + d) % 3) - 0.4 + 0.05 * d) for k in range(5)], post="cycle")
+            set_channels(doc, {f"hero/{joint}/{dof}": Channel(
+                [Key(0.25 * k, 0.3 * ((k + j + d) % 3) - 0.4 + 0.05 * d) for k in range(5)], post="cycle")})
     return doc
 
 
@@ -176,20 +178,59 @@ def test_handle_and_scale_drags_are_one_step_built_from_the_drag_start(qtbot, ed
     assert doc.channels[DRAGGED] == original
 
 
+def park_pointer_outside(qtbot, ed: CurveEditor) -> None:  # type: ignore[no-untyped-def]
+    """Put the real (Xvfb) pointer far from the editor and let its events arrive now.
+
+    Earlier tests leave the window system's pointer wherever their last no-button QTest
+    move put it (``QTest.mouseMove`` without a button moves the real pointer with
+    ``QCursor.setPos``; its motion event arrives later). If it sits over this plot, the
+    window system's Enter / Motion events at *that* spot can be handled in the middle of
+    this test and overwrite the hover our own moves set: the flake of busy full runs."""
+    corner = ed.mapToGlobal(QPoint(ed.width() + 300, ed.height() + 300))
+    QCursor.setPos(corner)
+    qtbot.waitUntil(lambda: QCursor.pos() == corner, timeout=2000)
+    qtbot.wait(20)  # the Leave / Motion events of the move are handled here, not later
+    QApplication.processEvents()
+
+
+def move_with_buttons(ed: CurveEditor, pos: QPoint, buttons: Qt.MouseButton) -> None:
+    """One mouse move on the plot carrying ``buttons``, delivered synchronously (events
+    already queued are handled first, so no late one lands after it)."""
+    QApplication.processEvents()
+    vp = ed.plot.viewport()
+    ev = QMouseEvent(QEvent.Type.MouseMove, QPointF(pos), QPointF(vp.mapToGlobal(pos)), Qt.MouseButton.NoButton,
+                     buttons, Qt.KeyboardModifier.NoModifier)
+    QApplication.sendEvent(vp, ev)
+
+
 def test_hover_ignores_a_button_held_down_elsewhere(qtbot, editor):
     """QTest remembers pressed buttons across widgets and tests: after a press whose
     release never came (a test that failed mid-drag), every later QTest mouse move says
-    that button is down. Hover goes by the presses this plot saw, so it still works."""
+    that button is down. Hover goes by the presses this plot saw, so it still works.
+
+    The moves are sent directly (with the stale button in ``buttons()``, as QTest's would
+    carry it) after parking the real pointer away from the plot: ``qtbot.mouseMove`` only
+    sends a synchronous event while QTest believes a button is down (else it moves the
+    real pointer and the hover changes a move late), and a real pointer left over the plot
+    by an earlier test could move the hover behind the test's back."""
     ed = editor
+    park_pointer_outside(qtbot, ed)
     other = QWidget()
     qtbot.addWidget(other)
     QTest.mousePress(other, Qt.MouseButton.RightButton, Qt.KeyboardModifier.NoModifier, QPoint(2, 2))
     try:
         vp = ed.plot.viewport()
-        qtbot.mouseMove(vp, key_pos(ed, DRAGGED, 3) + QPoint(1, 1))
+        stale = Qt.MouseButton.RightButton
+        move_with_buttons(ed, key_pos(ed, DRAGGED, 3) + QPoint(1, 1), stale)
         assert ed.view.hover == ("key", DRAGGED, 3)
         assert vp.cursor().shape() == Qt.CursorShape.SizeAllCursor
-        qtbot.mouseMove(vp, view_pos(ed, 80, -0.9))
+        move_with_buttons(ed, view_pos(ed, 80, -0.9), stale)
+        assert ed.view.hover is None
+        assert vp.cursor().shape() == Qt.CursorShape.ArrowCursor
+        # QTest's own move (synchronous while it remembers the button) agrees
+        qtbot.mouseMove(vp, key_pos(ed, DRAGGED, 3) + QPoint(1, 1))
+        assert ed.view.hover == ("key", DRAGGED, 3)
+        move_with_buttons(ed, view_pos(ed, 80, -0.9), stale)
         assert ed.view.hover is None
     finally:
         QTest.mouseRelease(other, Qt.MouseButton.RightButton, Qt.KeyboardModifier.NoModifier, QPoint(2, 2))

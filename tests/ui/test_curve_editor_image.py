@@ -17,6 +17,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from docfix import set_channels
 from PySide6.QtCore import QRect
 from PySide6.QtGui import QImage
 from PySide6.QtWidgets import QApplication
@@ -40,11 +41,11 @@ def _image_array(image: QImage) -> np.ndarray:
 
 def render_view(qtbot) -> tuple[QImage, CurveEditor]:
     doc = Document()
-    doc.channels["hero//x"] = Channel([Key(0.0, 0.0), Key(0.5, 2.0), Key(1.0, 1.0, "flat", "flat")], post="cycle")
-    doc.channels["hero/arm/angle"] = Channel(
-        [Key.make(0.25, -1.0, "linear", "linear"), Key.make(1.25, 1.5, 0.0, 3.0)], pre="linear", post="bounce")
-    doc.channels["hero//y"] = Channel([Key(0.1, 0.5), Key(0.6, -0.5), Key(0.9, 0.2)],
-                                      pre="cycle_offset", post="cycle_offset")
+    set_channels(doc, {"hero//x": Channel([Key(0.0, 0.0), Key(0.5, 2.0), Key(1.0, 1.0, "flat", "flat")], post="cycle")})
+    set_channels(doc, {"hero/arm/angle": Channel(
+        [Key.make(0.25, -1.0, "linear", "linear"), Key.make(1.25, 1.5, 0.0, 3.0)], pre="linear", post="bounce")})
+    set_channels(doc, {"hero//y": Channel([Key(0.1, 0.5), Key(0.6, -0.5), Key(0.9, 0.2)],
+                                      pre="cycle_offset", post="cycle_offset")})
     ctx = EditorContext(doc)
     ed = CurveEditor(ctx)
     qtbot.addWidget(ed)
@@ -95,7 +96,7 @@ def test_image_comparison_detects_a_changed_key(qtbot):
     if not REFERENCE.is_file():
         pytest.skip("no reference image")
     image, ed = render_view(qtbot)
-    ed.ctx.doc.channels["hero//y"] = ed.ctx.doc.channels["hero//y"].replace_keys({1: Key(0.7, 0.2)})
+    set_channels(ed.ctx.doc, {"hero//y": ed.ctx.doc.channels["hero//y"].replace_keys({1: Key(0.7, 0.2)})})
     ed.view.refresh_all()
     QApplication.processEvents()
     moved = grab_data_area(ed)

@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import pytest
+from docfix import set_channels
 from PySide6.QtCore import QEvent, QPoint, QPointF, Qt
 from PySide6.QtGui import QMouseEvent
 from PySide6.QtTest import QTest
@@ -38,9 +39,9 @@ def frames(ch: Channel) -> list[float]:
 
 def make_doc() -> Document:
     doc = Document()
-    doc.channels[X] = Channel([Key(f(fr), v) for fr, v in ((0, 0.0), (10, 1.0), (20, 2.0), (30, 3.0))])
-    doc.channels[ARM] = Channel([Key(f(fr), v) for fr, v in ((0, 0.5), (10, 1.5), (40, 2.5))])
-    doc.channels[LEG] = Channel([Key(f(fr), v) for fr, v in ((10, -1.0), (20, -2.0))])
+    set_channels(doc, {X: Channel([Key(f(fr), v) for fr, v in ((0, 0.0), (10, 1.0), (20, 2.0), (30, 3.0))])})
+    set_channels(doc, {ARM: Channel([Key(f(fr), v) for fr, v in ((0, 0.5), (10, 1.5), (40, 2.5))])})
+    set_channels(doc, {LEG: Channel([Key(f(fr), v) for fr, v in ((10, -1.0), (20, -2.0))])})
     return doc
 
 
@@ -311,8 +312,8 @@ def test_an_edit_redraws_the_rows_only_when_a_shown_row_draws_it(qtbot, sheet):
     view, ctx = sheet.view, sheet.ctx
     doc = make_doc()
     for j in range(60):  # rows that push "zz" below the visible ones
-        doc.channels[f"fill/j{j:02d}/angle"] = Channel([Key(0.0, 0.0), Key(1.0, float(j))])
-    doc.channels["zz/j59/angle"] = Channel([Key(0.0, 0.0), Key(1.0, 1.0)])
+        set_channels(doc, {f"fill/j{j:02d}/angle": Channel([Key(0.0, 0.0), Key(1.0, float(j))])})
+    set_channels(doc, {"zz/j59/angle": Channel([Key(0.0, 0.0), Key(1.0, 1.0)])})
     ctx.replace_document(doc)
     view.repaint()
     _first, last = view._visible_range()

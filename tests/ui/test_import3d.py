@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from docfix import set_parameters
 from PySide6.QtCore import QMimeData, QPointF, Qt, QUrl
 from PySide6.QtGui import QAction, QDropEvent
 
@@ -131,7 +132,7 @@ def test_export_gltf_action_and_round_trip(window, shared_data, tmp_path, dialog
     action = window.findChild(QAction, "actionExportGltf")
     assert action is not None and action in window.file_menu.actions()
     _before, aid = _opened(window, shared_data / "cse169" / "wasp_walk" / "wasp.skel", dialog_log)
-    window.doc.parameters["frame_end"] = 30
+    set_parameters(window.doc, {"frame_end": 30})
     out = tmp_path / "wasp.glb"
     from PySide6.QtWidgets import QFileDialog
 
@@ -156,7 +157,7 @@ def test_export_gltf_shows_its_messages(window, shared_data, tmp_path, dialog_lo
     from qtanimator.document.character3d import set_dofs_command
 
     window.ctx.push(set_dofs_command(window.doc, aid, {(j, "x"): 0.8 for j in range(1, 10)}, 0.0))
-    window.doc.parameters["frame_end"] = 2
+    set_parameters(window.doc, {"frame_end": 2})
     assert export_gltf_to(window, tmp_path / "m.glb")
     assert (tmp_path / "m.glb").is_file()
     assert window.last_export_warnings == [t for title, t in dialog_log if title == "glTF export"]

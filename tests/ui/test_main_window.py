@@ -5,6 +5,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from docfix import set_parameters
 
 from qtanimator.core.channel import Key
 from qtanimator.document import InsertKey
@@ -321,7 +322,7 @@ def test_editor_context_signals(qtbot):
     resets: list[bool] = []
     ctx.documentReset.connect(lambda: resets.append(True))
     new = Document()
-    new.parameters["frame_start"] = 10
+    set_parameters(new, {"frame_start": 10})
     ctx.replace_document(new)
     assert resets == [True] and ctx.frame == 10.0 and ctx.selection == ("", "")
     assert ctx.undo_stack.count() == 0 and ctx.undo_stack.isClean()

@@ -9,6 +9,7 @@ import math
 from pathlib import Path
 
 import pytest
+from PySide6.QtCore import Qt
 from PySide6.QtWidgets import QComboBox, QDoubleSpinBox, QGroupBox, QLabel
 
 from qtanimator.core.channel import Key
@@ -54,12 +55,21 @@ def test_driven_by_makes_a_spring_joint_in_one_undo_step(qtbot, rig) -> None:
     mix.setValue(0.5)
     assert c2d.spring_params(doc, aid).mix == 0.5
     assert preset.currentText() == "custom"
-    mix.setValue(2.0)  # refused: mix is 0 … 1
+    typed(qtbot, mix, "2")  # refused (mix is 0 … 1), not clamped to 1
     assert c2d.spring_params(doc, aid).mix == 0.5
+    assert mix.maximum() == 1.0
     for _ in range(3):
         window.ctx.undo_stack.undo()
     assert not c2d.character(doc, aid).joints[2].is_spring
     assert "rig" not in doc.assets[aid].properties
+
+
+def typed(qtbot, box: QDoubleSpinBox, text: str) -> None:
+    """Type ``text`` into a field as a user does (select all, type, Enter)."""
+    qtbot.mouseClick(box, Qt.MouseButton.LeftButton)
+    qtbot.keyClick(box, Qt.Key.Key_A, Qt.KeyboardModifier.ControlModifier)
+    qtbot.keyClicks(box, text)
+    qtbot.keyClick(box, Qt.Key.Key_Return)
 
 
 def test_the_root_cannot_become_a_pendulum(qtbot, rig) -> None:
@@ -81,7 +91,7 @@ def test_bounce_is_a_pendulum_parameter(qtbot, rig) -> None:
     assert box.value() == pytest.approx(0.5)
     box.setValue(0.9)
     assert c2d.pendulum_params(window.doc, aid).restitution == 0.9
-    box.setValue(1.5)  # refused
+    typed(qtbot, box, "1.5")  # refused (a bounce above 1 would gain energy), not clamped to 1
     assert c2d.pendulum_params(window.doc, aid).restitution == 0.9
 
 

@@ -2,7 +2,8 @@
 
 ``light1.position`` / ``light1.color`` / ``light1.intensity`` (and ``light2.*``, and
 ``lights.ambient``) are ordinary parameters changed with ``SetParameter`` commands, so they
-are saved with the project and undoable. Missing parameters take the defaults below.
+are saved with the project and undoable. Missing parameters take the defaults below
+(from the schema, :mod:`qtanimator.document.parameters`).
 """
 
 from __future__ import annotations
@@ -12,18 +13,11 @@ from typing import Any
 
 import numpy as np
 
-LIGHT_NAMES = ("light1", "light2")
-AMBIENT_PARAMETER = "lights.ambient"
+from qtanimator.document.parameters import AMBIENT_PARAMETER, LIGHT_NAMES, LIGHTS, defaults
 
-DEFAULTS: dict[str, Any] = {
-    "light1.position": [4.0, 6.0, 5.0],
-    "light1.color": [1.0, 0.95, 0.85],
-    "light1.intensity": 0.8,
-    "light2.position": [-5.0, 3.0, -3.0],
-    "light2.color": [0.55, 0.65, 1.0],
-    "light2.intensity": 0.5,
-    AMBIENT_PARAMETER: [0.16, 0.16, 0.18],
-}
+#: The defaults of the lights' parameters: a view of the schema
+#: (:data:`qtanimator.document.parameters.LIGHTS`, which also holds their ranges).
+DEFAULTS: dict[str, Any] = defaults(LIGHTS)
 
 
 @dataclass

@@ -203,7 +203,9 @@ class SkinnedMesh(Mesh):
 # ------------------------------------------------------------------ primitives
 def box_geometry() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The unit cube [0, 1]³ with one normal per face (24 vertices, 12 triangles)."""
-    pos, nrm, tri = [], [], []
+    pos: list[np.ndarray] = []
+    nrm: list[np.ndarray] = []
+    tri: list[tuple[int, int, int]] = []
     for axis in range(3):
         for side in (0.0, 1.0):
             n = np.zeros(3)

@@ -660,11 +660,11 @@ class SceneRenderer:
                             np.tile((0.55, 0.6, 0.55, 1.0), (len(models), 1)))
         if item.pinned is not None and len(item.pinned):
             k = len(item.pinned)
-            models = np.tile(np.eye(4), (k, 1, 1))
-            models[:, :3, :3] *= 0.02
-            models[:, :3, 3] = item.pinned
+            pins = np.tile(np.eye(4), (k, 1, 1))
+            pins[:, :3, :3] *= 0.02
+            pins[:, :3, 3] = item.pinned
             p.set("u_lit", 0)
-            self._instanced(self._sphere, models, np.tile((1.0, 0.85, 0.2, 1.0), (k, 1)))
+            self._instanced(self._sphere, pins, np.tile((1.0, 0.85, 0.2, 1.0), (k, 1)))
             p.set("u_lit", 1)
 
     def _draw_light_gizmos(self, lights: Sequence[Light], size: float) -> None:

@@ -31,6 +31,7 @@ from PySide6.QtGui import QColor, QPainter, QPainterPath, QPen, QPixmap, QTransf
 from PySide6.QtWidgets import QGraphicsItem
 
 from qtanimator.core.channel import Channel
+from qtanimator.ui.curves.drags import handle_extents
 from qtanimator.ui.curves.paths import (
     LINE_TO,
     MOVE_TO,
@@ -110,21 +111,6 @@ def handle_offsets(tr: QTransform, slope: FloatArray,
             ox = np.where(real, dx * e, ox)
             oy = np.where(real, dy * e, oy)
     return ox, oy
-
-
-def handle_extents(channel: Channel) -> tuple[FloatArray, FloatArray] | None:
-    """Per key, the time extents (seconds) of the in and out handles drawn at their real
-    length — the sides of weighted spans, as evaluation uses them — and NaN for handles
-    drawn at the fixed length; None when the channel has no weighted span."""
-    if not channel.is_weighted:
-        return None
-    weighted, h_out, h_in = channel.span_handles()
-    n = len(channel.keys)
-    ins = np.full(n, np.nan)
-    outs = np.full(n, np.nan)
-    outs[:-1] = np.where(weighted, h_out, np.nan)
-    ins[1:] = np.where(weighted, h_in, np.nan)
-    return ins, outs
 
 
 def display_transform(offset: float, scale: float) -> QTransform:
