@@ -23,7 +23,6 @@ transforms are rotations about pivots, the mirroring is baked into the shapes.
 from __future__ import annotations
 
 import math
-import weakref
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TypeAlias
@@ -163,11 +162,8 @@ class _ChainPlan:
         self.follow_pos = np.array(follow_k, dtype=np.intp)
 
 
-_PLANS: weakref.WeakKeyDictionary[Character, dict[tuple[int, bool], _ChainPlan]] = weakref.WeakKeyDictionary()
-
-
 def _plan(character: Character, joint: int, freeze_root: bool) -> _ChainPlan:
-    plans = _PLANS.setdefault(character, {})
+    plans: dict[tuple[int, bool], _ChainPlan] = character.derived.setdefault("ik.plans", {})
     key = (int(joint), bool(freeze_root))
     plan = plans.get(key)
     if plan is None:

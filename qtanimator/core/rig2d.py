@@ -195,6 +195,10 @@ class Character:
         #: The rig spec that rebuilds this character from its SVG (plain data; the asset
         #: property ``rig`` once it is rigged in the program), or None.
         self.rig_spec: dict[str, Any] | None = None
+        #: Data others derive from this character on first use and keep with it (the IK
+        #: solver's chain plans, the 2D painter's outlines), by the user's key: owned, like
+        #: the character, by the document's runtime and dropped with it; never saved.
+        self.derived: dict[str, Any] = {}
         for i, j in enumerate(joints):
             if i == 0 and j.parent is not None:
                 raise ValueError("the first joint must be the root")

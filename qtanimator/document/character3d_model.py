@@ -1,5 +1,6 @@
 """What a 3D character asset loads (:class:`Character3D`: skeleton, skin, meshes, clips), its
-parts and clips, and the DOF names and asset properties of 3D characters.
+parts and clips, the DOF names and asset properties of 3D characters, and :func:`character`,
+the loaded character of an asset.
 
 The data only: :mod:`qtanimator.document.character3d` loads characters and works with them in
 the document; the glTF modules (:mod:`~qtanimator.document.gltf_character`,
@@ -21,6 +22,7 @@ from qtanimator.core.quaternion_channels import QUATERNION_DOFS
 from qtanimator.core.rotation import euler_to_quaternions
 from qtanimator.core.skeleton import Skeleton
 from qtanimator.core.skinning import Skin
+from qtanimator.document.document import Document
 from qtanimator.formats.obj import Mesh
 
 FloatArray = npt.NDArray[np.float64]
@@ -160,3 +162,9 @@ class Character3D:
             self._rest_quaternions = out
         return self._rest_quaternions
 
+
+def character(doc: Document, asset_id: str) -> Character3D:
+    rt = doc.runtime.get(asset_id)
+    if not isinstance(rt, Character3D):
+        raise KeyError(f"{asset_id!r} is not a loaded 3D character")
+    return rt

@@ -45,11 +45,11 @@ import numpy.typing as npt
 
 from qtanimator.core.rotation import matrices_to_quaternions, polar
 from qtanimator.core.skinning import Skin, skin_positions
-from qtanimator.document.character3d import character, clip_channels_of, clip_duration
-from qtanimator.document.character3d_model import Character3D, MeshPart, TextureImage
+from qtanimator.document.character3d_model import Character3D, MeshPart, TextureImage, character
+from qtanimator.document.clips3d import clip_channels_of, clip_duration
 from qtanimator.document.document import Document
 from qtanimator.document.gltf_export_clips import clip_animation, rest_rotations
-from qtanimator.formats.gltf.character import CharacterExport
+from qtanimator.document.gltf_skeleton_export import CharacterExport
 from qtanimator.formats.gltf.model import (
     GltfImage,
     GltfMesh,

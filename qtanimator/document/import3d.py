@@ -42,12 +42,12 @@ import numpy.typing as npt
 
 from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key, Tangent
 from qtanimator.core.rotation import euler_from_matrices
+from qtanimator.document.channels3d import anim_channel_ids
 from qtanimator.document.character3d import (
     ASSET_KIND,
     BVH_POSITIONS,
     CLIP,
     Character3D,
-    _channel_ids,
     add_character3d_command,
     character,
     clip_range_command,
@@ -67,10 +67,10 @@ from qtanimator.document.gltf_character import (
     load_gltf_character_asset,
 )
 from qtanimator.document.gltf_export import character_scene
+from qtanimator.document.gltf_skeleton_export import CharacterExport
 from qtanimator.document.placement import CHARACTER_HEIGHT, FAR_FROM_UNIT, GAP, PLACEMENT
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.errors import FormatError
-from qtanimator.formats.gltf.character import CharacterExport
 from qtanimator.formats.gltf.reader import import_gltf
 from qtanimator.formats.gltf.writer import export_glb
 from qtanimator.formats.skel import load_skel
@@ -331,7 +331,7 @@ def bvh_import(doc: Document, path: str | os.PathLike[str]) -> Import:
     p = Path(path)
     runtime, chans = load_bvh_character(p)
     aid = doc.unique_asset_id(_asset_base(p))
-    ids = _channel_ids(aid, runtime.skeleton.joint_keys())
+    ids = anim_channel_ids(aid, runtime.skeleton.joint_keys())
     channels = {cid: ch for cid, ch in zip(ids, chans) if ch is not None}
     channels.update(runtime.translation_channels(aid))
     # The root-position convention detected (or chosen later in Properties) is saved with

@@ -34,7 +34,7 @@ from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, fields
 from typing import Any
 
-from qtanimator.core import cloth as _cloth
+from qtanimator.core import cloth_params as _cloth
 from qtanimator.core import ik_methods
 from qtanimator.core.pendulum import INTEGRATORS as PENDULUM_INTEGRATORS
 from qtanimator.core.pendulum import MIN_STEP, PRESETS, PendulumParams

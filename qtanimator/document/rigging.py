@@ -25,7 +25,7 @@ import numpy as np
 
 from qtanimator.core.channel import Channel
 from qtanimator.core.rig2d import Character
-from qtanimator.document.character2d import ASSET_KIND, character, load_character_asset
+from qtanimator.document.character2d_asset import ASSET_KIND, character, load_character_asset
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Asset, Document, split_channel_id
 

@@ -41,8 +41,9 @@ import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.rig2d import Character
-from qtanimator.document.character2d import character, evaluate_pose, placement_matrix
+from qtanimator.document.character2d_asset import character
 from qtanimator.document.document import Document
+from qtanimator.document.evaluation2d import evaluate_pose, placement_matrix
 
 FloatArray = npt.NDArray[np.float64]
 

@@ -62,7 +62,7 @@ from typing import Any
 import numpy as np
 
 from qtanimator.core.channel import Channel, Interpolation, Key, Tangent
-from qtanimator.document.character2d import (
+from qtanimator.document.character2d_asset import (
     ASSET_KIND,
     angle_channel_id,
     character,

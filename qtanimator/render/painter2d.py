@@ -14,7 +14,6 @@ drawing of earlier versions): fills, strokes (width, colour, alpha) and element 
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Iterable, Sequence
 
 import numpy as np
@@ -38,11 +37,8 @@ from qtanimator.document.document import Document
 from qtanimator.document.outliner import is_hidden
 from qtanimator.render.svg_draw import draw_joint
 
-_PATHS: weakref.WeakKeyDictionary[Character, list[list[QPainterPath]]] = weakref.WeakKeyDictionary()
-
 HIGHLIGHT_SELECTED = 0.5
 HIGHLIGHT_HOVER = 0.35
-_SILHOUETTES: weakref.WeakKeyDictionary[Character, dict[int, QPainterPath]] = weakref.WeakKeyDictionary()
 
 
 def shape_path(shape: Shape) -> QPainterPath:
@@ -60,16 +56,16 @@ def shape_path(shape: Shape) -> QPainterPath:
 
 def character_paths(ch: Character) -> list[list[QPainterPath]]:
     """QPainterPaths of every joint's shapes, built once per character."""
-    paths = _PATHS.get(ch)
+    paths: list[list[QPainterPath]] | None = ch.derived.get("painter2d.paths")
     if paths is None:
         paths = [[shape_path(s) for s in j.shapes] for j in ch.joints]
-        _PATHS[ch] = paths
+        ch.derived["painter2d.paths"] = paths
     return paths
 
 
 def joint_silhouette(ch: Character, joint: int) -> QPainterPath:
     """The area a joint's geometry covers (fills and stroke bands united), built once."""
-    cache = _SILHOUETTES.setdefault(ch, {})
+    cache: dict[int, QPainterPath] = ch.derived.setdefault("painter2d.silhouettes", {})
     path = cache.get(joint)
     if path is None:
         path = QPainterPath()

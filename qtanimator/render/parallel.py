@@ -47,7 +47,7 @@ class ChunkSpec:
 def bake_2d(doc: Any, times: Sequence[float]) -> tuple[dict[str, Any], tuple[float, float, float, float]]:
     """Simulate the pendulums over ``times`` in this process and fix the camera:
     ``(baked states, (x, y, w, h))``."""
-    from qtanimator.document.character2d import simulation
+    from qtanimator.document.pendulum_cache import simulation
     from qtanimator.render.painter2d import animation_bounds
 
     view = animation_bounds(doc, times)  # evaluates every pose: the pendulums are simulated here
@@ -156,7 +156,7 @@ def render_chunk(spec: ChunkSpec | Chunk3D) -> list[Any]:
     ensure_gui_app()
     from PySide6.QtCore import QRectF
 
-    from qtanimator.document.character2d import simulation
+    from qtanimator.document.pendulum_cache import simulation
     from qtanimator.render.painter2d import image_to_array, render_frame
 
     doc = _worker_document(spec.scene, spec.fps)

@@ -28,7 +28,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from qtanimator.core.cloth import ClothParams, Sphere
+from qtanimator.core.cloth_params import ClothParams, Sphere
 from qtanimator.document.cloth import ASSET_KIND, add_cloth_command, cloth_params, set_cloth_param_command
 from qtanimator.document.document import DocumentChange
 from qtanimator.document.parameters import CLOTH, CLOTH_SPHERE_CENTRE, CLOTH_SPHERE_RADIUS, CLOTH_WIND_SPEED, Param

@@ -19,11 +19,11 @@ from PySide6.QtCore import QAbstractEventDispatcher, QCoreApplication, QElapsedT
 from PySide6.QtGui import QUndoStack
 
 from qtanimator.core.rig2d import Character
-from qtanimator.document.character2d import ensure_caches
-from qtanimator.document.character3d import Character3D
+from qtanimator.document.character3d_model import Character3D
 from qtanimator.document.commands import Command
 from qtanimator.document.document import Document, DocumentChange
 from qtanimator.document.gesture import Gesture
+from qtanimator.document.pendulum_cache import ensure_caches
 from qtanimator.document.pose import clear_pending
 from qtanimator.document.simulation import (
     pause_workers,

@@ -14,7 +14,8 @@ from typing import TYPE_CHECKING, Any, ClassVar
 from PySide6.QtCore import Signal
 from PySide6.QtWidgets import QWidget
 
-from qtanimator.document.cloth_worker import ClothWorker, LiveCloths
+from qtanimator.document.cloth_worker import ClothWorker
+from qtanimator.document.live_cloth import LiveCloths
 from qtanimator.render.gl.camera import OrbitCamera
 from qtanimator.render.gl.renderer import SceneItem, ViewOptions
 from qtanimator.ui.context import EditorContext

@@ -2,7 +2,7 @@
 
 A :class:`~qtanimator.document.cloth_worker.ClothWorker` fills the document's cloth caches in
 the background (the view draws the newest frame there and never waits), and the interactive
-cloth is a :class:`~qtanimator.document.cloth_worker.LiveCloths` stepping in real time on its
+cloth is a :class:`~qtanimator.document.live_cloth.LiveCloths` stepping in real time on its
 own thread. A timer polls both and repaints when something new is there; the Cloth dock
 hears the progress (``clothProgressChanged``). Keys W/A/S/D/Q/E move the live cloth's pins
 (CSE169), Z/C rotate them, P pauses it, Shift+R resets it; a left drag on it grabs it.
@@ -14,8 +14,9 @@ import math
 
 from PySide6.QtCore import QElapsedTimer, Qt, QTimer
 
-from qtanimator.document.cloth_worker import LiveCloths, cloth_worker
+from qtanimator.document.cloth_worker import cloth_worker
 from qtanimator.document.document import Document
+from qtanimator.document.live_cloth import LiveCloths
 from qtanimator.ui.view3d_base import ViewPart
 
 #: Cloth pin moves per key press: metres and radians.

@@ -22,7 +22,7 @@ placement drag. View ▸ 3D Camera… shows the camera's distance, azimuth and i
 Cloth never runs on the UI thread: a :class:`~qtanimator.document.cloth_worker.ClothWorker`
 fills the document's cloth caches in the background (the view draws the newest frame there
 and never waits), and the interactive cloth is a
-:class:`~qtanimator.document.cloth_worker.LiveCloths` stepping in real time on its own thread.
+:class:`~qtanimator.document.live_cloth.LiveCloths` stepping in real time on its own thread.
 A timer polls both and repaints when something new is there.
 
 The parts, one module per idea (every public name is importable from here):
@@ -61,7 +61,7 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from qtanimator.document.cloth_worker import LiveCloths
+from qtanimator.document.live_cloth import LiveCloths
 from qtanimator.render.gl.renderer import WEIGHTS_ALL, WEIGHTS_OFF, ClothDraw
 from qtanimator.render.scene3d import joint_index
 from qtanimator.ui.camera_fields import show_camera_dialog

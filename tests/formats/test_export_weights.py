@@ -11,8 +11,8 @@ import pytest
 
 from qtanimator.core.channel import Channel, Key
 from qtanimator.core.clip import AnimationClip
+from qtanimator.document.gltf_skeleton_export import GltfExportWarning, build_character_scene
 from qtanimator.formats.anim import AnimExportWarning, format_anim, load_anim, parse_anim, save_anim
-from qtanimator.formats.gltf import GltfExportWarning, build_character_scene
 from qtanimator.formats.skel import load_skel
 from qtanimator.formats.skin import load_skin
 

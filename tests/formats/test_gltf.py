@@ -20,14 +20,13 @@ from qtanimator.core.channel import Channel, Key
 from qtanimator.core.clip import apply_clip, channel_index
 from qtanimator.core.skeleton import Skeleton
 from qtanimator.core.skinning import Skin, SkinBinding, skin_positions
+from qtanimator.document.gltf_skeleton_export import GltfExportWarning, export_character_glb
 from qtanimator.formats import FormatError
 from qtanimator.formats.anim import load_anim
 from qtanimator.formats.attach import load_attach
 from qtanimator.formats.glb import build_glb, read_glb
 from qtanimator.formats.gltf import (
-    GltfExportWarning,
     GltfSampler,
-    export_character_glb,
     export_glb,
     glb_bytes,
     import_gltf,

@@ -40,8 +40,9 @@ from qtanimator.document.character3d import (
     skinned_mesh,
     world_matrices,
 )
+from qtanimator.document.gltf_skeleton_export import export_character_glb
 from qtanimator.document.import3d import export_gltf, import_file
-from qtanimator.formats.gltf import export_character_glb, import_gltf
+from qtanimator.formats.gltf import import_gltf
 
 #: Positions may differ by this fraction of the model's size (the rest mesh's bounding-box diagonal).
 TOLERANCE = 1e-6

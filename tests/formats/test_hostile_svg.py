@@ -209,7 +209,7 @@ def test_flattening_matches_point_by_point_sampling() -> None:
     ch = parse_character(rig(f'<path d="{d}"/>').encode(), "x")
     got = ch.joints[0].shapes[0].points
     expected = [(0.0, 0.0)]
-    from qtanimator.formats.svg_rig import _samples
+    from qtanimator.formats.svg_builder import _samples
 
     for seg in se.Path(d).segments():
         if isinstance(seg, (se.CubicBezier, se.QuadraticBezier, se.Arc)):

@@ -12,12 +12,9 @@ the skinned mesh node's own transform is ignored and joint j moves vertices by
 Export: :func:`export_glb` writes a :class:`GltfScene` (one buffer, one buffer view per
 accessor, 4-byte aligned, min / max on every accessor, the JSON chunk padded with spaces
 and the BIN chunk with zeros). A whole character (every mesh and clip, keys as they are) is
-turned into such a scene by :mod:`qtanimator.document.gltf_export`.
-:func:`export_character_glb` is the older path for one skeleton, one skin and ``.anim``-layout
-channels: joints become nodes, each vertex keeps its strongest four influences (renormalised,
-with a :class:`GltfExportWarning` when that visibly changes the animated shape), and the
-animation is sampled at ``fps`` with LINEAR or CUBICSPLINE interpolation, time 0 at
-``start``; a channel with weighted tangents (issue 13) is sampled and named in a warning.
+turned into such a scene by :mod:`qtanimator.document.gltf_export`, and one skeleton + skin +
+``.anim`` channels without a document by :mod:`qtanimator.document.gltf_skeleton_export`
+(character export belongs to the document layer; this package reads and writes scenes).
 
 Every malformed file raises :class:`~qtanimator.formats.FormatError`.
 
@@ -26,7 +23,6 @@ dataclasses and pose evaluation), :mod:`~qtanimator.formats.gltf.reader` (import
 :mod:`~qtanimator.formats.gltf.accessors` and :mod:`~qtanimator.formats.gltf.buffers`
 (validated JSON access, accessor and buffer data), :mod:`~qtanimator.formats.gltf.writer`
 (export), :mod:`~qtanimator.formats.gltf.sampling` (export sample times),
-:mod:`~qtanimator.formats.gltf.character` (the skeleton + skin export) and
 :mod:`~qtanimator.formats.gltf.constants`. Every public name is importable from here too.
 """
 
@@ -34,12 +30,6 @@ from __future__ import annotations
 
 from qtanimator.core.rotation import quaternion_to_matrix
 from qtanimator.formats.gltf.buffers import contained_path
-from qtanimator.formats.gltf.character import (
-    CharacterExport,
-    GltfExportWarning,
-    build_character_scene,
-    export_character_glb,
-)
 from qtanimator.formats.gltf.constants import (
     ARRAY_BUFFER,
     BYTE,
@@ -78,8 +68,8 @@ __all__ = [
     "ARRAY_BUFFER", "BYTE", "ELEMENT_ARRAY_BUFFER", "FLOAT", "INTERPOLATIONS", "MAX_ZERO_ELEMENTS", "PATHS",
     "SHORT", "TRIANGLES", "TRIANGLE_FAN", "TRIANGLE_STRIP", "UNSIGNED_BYTE", "UNSIGNED_INT", "UNSIGNED_SHORT",
     "WEIGHT_SUM_TOLERANCE",
-    "CharacterExport", "FloatArray", "GltfAnimation", "GltfAnimationChannel", "GltfExportWarning", "GltfImage",
+    "FloatArray", "GltfAnimation", "GltfAnimationChannel", "GltfImage",
     "GltfMesh", "GltfNode", "GltfPrimitive", "GltfSampler", "GltfScene", "GltfSkin", "IntArray",
-    "build_character_scene", "contained_path", "export_character_glb", "export_glb", "glb_bytes", "import_gltf",
+    "contained_path", "export_glb", "glb_bytes", "import_gltf",
     "parse_gltf", "quaternion_to_matrix", "sample_times", "scene_to_gltf", "summarize",
 ]

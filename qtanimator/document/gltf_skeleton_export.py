@@ -1,6 +1,9 @@
-"""Exporting one skeleton, one skin and ``.anim``-layout channels as a glTF scene (the older
-path; :mod:`qtanimator.document.gltf_export` writes whole document characters): joints become
-nodes, each vertex keeps its strongest influences, and the animation is sampled.
+"""Exporting one skeleton, one skin and ``.anim``-layout channels as a glTF scene, without a
+document (the older path, kept for scripts and the format tests; File ▸ Export glTF… and
+``qtanimator export`` use :mod:`qtanimator.document.gltf_export`, which writes whole document
+characters with every influence): joints become nodes, each vertex keeps its strongest
+influences, and the animation is sampled. :class:`CharacterExport` is the result both paths
+return.
 """
 
 from __future__ import annotations
