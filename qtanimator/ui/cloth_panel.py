@@ -16,6 +16,7 @@ from typing import Any
 
 from PySide6.QtCore import Qt
 from PySide6.QtWidgets import (
+    QAbstractSpinBox,
     QCheckBox,
     QComboBox,
     QFormLayout,
@@ -61,6 +62,10 @@ GROUPS = (
                     "collision_margin")),
     ("Pins and solver", ("pin_mode", "custom_pins", "integrator", "substeps")),
 )
+
+
+#: The narrowest a field in a row of several (a vector, the sphere) may get, in pixels.
+COMPONENT_MIN_WIDTH = 48
 
 
 def _label(name: str) -> str:
@@ -187,6 +192,15 @@ class ClothPanel(QWidget):
         self.message.setText(reason)
 
     def _make_editor(self, name: str, parent: QWidget) -> QWidget:
+        widget = self._editor(name, parent)
+        # The fields of a row (a vector, the sphere) may be narrower than their widest value
+        # needs, so the rows fit the dock's width with the unit in the label (no sideways
+        # scrolling); a single field fills its row anyway.
+        for spin in widget.findChildren(QAbstractSpinBox):
+            spin.setMinimumWidth(COMPONENT_MIN_WIDTH)
+        return widget
+
+    def _editor(self, name: str, parent: QWidget) -> QWidget:
         param = CLOTH[name]
         if param.kind == "float":
             s = self._spin(param, name, parent)
