@@ -1,0 +1,106 @@
+"""tools/mutation.py: the mutation sites it finds on a tiny module (not a mutation run)."""
+
+from __future__ import annotations
+
+import ast
+import importlib.util
+import sys
+import textwrap
+from pathlib import Path
+
+import pytest
+
+TOOL = Path(__file__).resolve().parents[1] / "tools" / "mutation.py"
+
+
+@pytest.fixture(scope="module")
+def mutation():  # type: ignore[no-untyped-def]
+    spec = importlib.util.spec_from_file_location("qtanimator_mutation_tool", TOOL)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module
+    spec.loader.exec_module(module)
+    yield module
+    sys.modules.pop(spec.name, None)
+
+
+def _mutants(mutation, tmp_path: Path, code: str) -> list[tuple[str, str]]:  # type: ignore[no-untyped-def]
+    source = textwrap.dedent(code)
+    path = tmp_path / "tiny.py"
+    path.write_text(source, encoding="utf-8")
+    found = mutation.mutation_sites(path.read_text(encoding="utf-8"), "tiny.py")
+    for m in found:  # every mutant applies and parses
+        ast.parse(mutation.apply_mutant(source, m))
+    return [(m.before, m.after) for m in found]
+
+
+def test_arithmetic_swap(mutation, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    assert _mutants(mutation, tmp_path, "def f(a, b):\n    x = a + b\n") == [("a + b", "(a - b)")]
+    source = "def f(a, b):\n    x = a + b\n"
+    (m,) = mutation.mutation_sites(source, "tiny.py")
+    assert mutation.apply_mutant(source, m) == "def f(a, b):\n    x = (a - b)\n"
+
+
+def test_precedence_is_kept(mutation, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    got = _mutants(mutation, tmp_path, "def f(a, b, c):\n    y = (a + b) * c\n")
+    assert got == [("(a + b) * c", "((a + b) / c)"), ("a + b", "(a - b)")]
+
+
+def test_docstrings_strings_annotations_and_all_yield_nothing(mutation, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    code = '''
+        """Module docstring 1 + 2."""
+        from typing import TYPE_CHECKING
+        __all__ = ["f"]
+        if TYPE_CHECKING:
+            X = 1 + 2
+        def f(a: int = 0) -> "list[int]":
+            """Docstring with a < b."""
+            s = "a" + "b"
+            t = f"{a + 1}"
+            u = "%d" % (a - 1)
+            log.debug("x %s", a + 1)
+            raise ValueError(a + 1)
+    '''
+    assert _mutants(mutation, tmp_path, code) == [("0", "(1)")]  # the default value only
+
+
+def test_each_operator(mutation, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    code = """
+        def f(a, b):
+            if a < b and not a:
+                return -a
+            return a == b, True
+    """
+    assert set(_mutants(mutation, tmp_path, code)) == {
+        ("a < b", "(a <= b)"),
+        ("a < b and not a", "(a < b or not a)"),
+        ("not a", "(a)"),
+        ("-a", "(a)"),
+        ("return -a", "return None"),
+        ("a == b", "(a != b)"),
+        ("True", "(False)"),
+        ("return a == b, True", "return None"),
+    }
+
+
+def test_numbers_and_augmented_assignment(mutation, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+    code = """
+        def f(x) -> None:
+            x += 2.5
+            return
+    """
+    assert set(_mutants(mutation, tmp_path, code)) == {("x += 2.5", "x -= 2.5"), ("2.5", "(3.5)")}
+
+
+def test_sampling_is_repeatable(mutation) -> None:  # type: ignore[no-untyped-def]
+    source = "def f(a):\n" + "".join(f"    a = a + {i}\n" for i in range(30))
+    sites = mutation.mutation_sites(source, "m.py")
+    first = mutation.sample_sites(sites, 5, 17, "m.py", source)
+    assert first == mutation.sample_sites(sites, 5, 17, "m.py", source)
+    assert len(first) == 5 and first != mutation.sample_sites(sites, 5, 18, "m.py", source)
+    assert mutation.sample_sites(sites, 1000, 17, "m.py") == sites
+
+
+def test_wilson_interval(mutation) -> None:  # type: ignore[no-untyped-def]
+    lo, hi = mutation.wilson(90, 100)
+    assert 0.82 < lo < 0.84 and 0.94 < hi < 0.95
