@@ -28,126 +28,33 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass, fields, replace
 from typing import Any
 
 import numpy as np
 import numpy.typing as npt
 
 from qtanimator.core.joint_bounce import ON_LIMIT, Bounce, BoundedUnit, bounded_step, hermite
+
+# Re-exported: the groups and pivot accelerations, the constants and the blow-up check.
+from qtanimator.core.pendulum_groups import (
+    PendulumGroup,
+    build_groups,
+    perp,
+    pivot_accelerations,
+    rotate,
+    rotation_pivot_terms,
+)
+from qtanimator.core.pendulum_params import (
+    INTEGRATORS,
+    MIN_STEP,
+    PRESETS,
+    RUNAWAY_RATE,
+    FloatArray,
+    PendulumBlowUp,
+    PendulumParams,
+    check_state,
+)
 from qtanimator.core.rig2d import Character
-
-FloatArray = npt.NDArray[np.float64]
-
-INTEGRATORS = ("symplectic_euler", "leapfrog", "rk4")
-#: The smallest internal step (s): 1,667 steps per 60 Hz frame. A step of 1e-9 s would make
-#: one frame 16 million steps, a simulation that never ends.
-MIN_STEP = 1.0e-5
-
-
-@dataclass(frozen=True)
-class PendulumParams:
-    """Simulation constants of one character.
-
-    ``g`` (units/s²) pulls towards +y. ``damping`` is a in ω ← ω·e^(−aτ) (1/s).
-    ``restitution`` e (0 … 1) is the share of its speed a joint keeps when it bounces off
-    one of its angle limits (0: it stops dead; 1: a perfect bounce).
-    ``length_scale`` scales y0 and the chain offsets before anything uses them (the handout's
-    1/1000). ``accel_scale`` / ``rotation_accel_scale`` scale the pivot acceleration from the
-    root's translation and from keyframed ancestors' rotation. ``inertia`` is ``exact`` or
-    ``reference`` (the starter's formulas). ``point_mass_forcing`` uses the handout's 1/L² in
-    place of m/I in the forcing term. ``step`` is the fixed internal step in seconds.
-    """
-
-    g: float = 3000.0
-    damping: float = 0.3
-    restitution: float = 0.5
-    length_scale: float = 1.0
-    accel_scale: float = 1.0
-    rotation_accel_scale: float = 1.0
-    inertia: str = "exact"
-    point_mass_forcing: bool = False
-    coupled: bool = True
-    integrator: str = "symplectic_euler"
-    step: float = 1.0 / 600.0
-
-    def __post_init__(self) -> None:
-        if self.inertia not in ("exact", "reference"):
-            raise ValueError("inertia must be 'exact' or 'reference'")
-        if self.integrator not in INTEGRATORS:
-            raise ValueError(f"integrator must be one of {', '.join(INTEGRATORS)}")
-        if not (self.step >= MIN_STEP and math.isfinite(self.step)):
-            raise ValueError(f"the step must be at least {MIN_STEP:g} s (a frame would take too many steps)")
-        for name in ("g", "damping", "length_scale", "accel_scale", "rotation_accel_scale"):
-            if not math.isfinite(float(getattr(self, name))):
-                raise ValueError(f"{name} must be finite")
-        if not 0.0 <= float(self.restitution) <= 1.0:
-            raise ValueError("restitution must be between 0 (a joint stops at its limit) and 1 (a perfect bounce)")
-
-    def to_dict(self) -> dict[str, Any]:
-        return asdict(self)
-
-    @classmethod
-    def from_dict(cls, d: dict[str, Any]) -> PendulumParams:
-        names = {f.name: f.type for f in fields(cls)}
-        kw = {k: v for k, v in d.items() if k in names}
-        return replace(cls(), **kw)
-
-
-#: Named presets. ``physical`` (the default) uses exact moments, per-second units and coupled
-#: chains. ``handout`` is the CMU handout's Task 3B: g = 5000, lengths / 1000,
-#: rotation acceleration × 10000, damping a = 1, τ = 1/60 s, the starter's moments and the
-#: 1/L² forcing. The handout measures accelerations per frame² (at 60 frames per second);
-#: our pivot accelerations are per s², hence the 1/3600 factors.
-PRESETS: dict[str, PendulumParams] = {
-    "physical": PendulumParams(),
-    "handout": PendulumParams(g=5000.0, damping=1.0, length_scale=0.001, accel_scale=1.0 / 3600.0,
-                              rotation_accel_scale=10000.0 / 3600.0, inertia="reference",
-                              point_mass_forcing=True, coupled=False, step=1.0 / 60.0),
-    # Task 3A: θ'' = −m g L sin θ / I with g = 3, no pivot acceleration.
-    "handout_3a": PendulumParams(g=3.0, damping=1.0, accel_scale=0.0, rotation_accel_scale=0.0,
-                                 inertia="reference", coupled=False, step=1.0 / 60.0),
-}
-
-
-#: Angular speeds above this (rad/s, about 160 turns per second) count as a blow-up even
-#: while the numbers are still finite: no pendulum an animator keys swings that fast.
-RUNAWAY_RATE = 1.0e3
-
-
-class PendulumBlowUp(RuntimeError):
-    """A pendulum simulation went unstable at ``time`` (s); ``parameter`` names the setting
-    to change first, ``joint`` the joint that ran away."""
-
-    def __init__(self, message: str, parameter: str, time: float, joint: str) -> None:
-        super().__init__(message)
-        self.message = message
-        self.parameter = parameter
-        self.time = time
-        self.joint = joint
-
-
-def check_state(character: Character, params: PendulumParams, theta: FloatArray, omega: FloatArray,
-                time: float) -> PendulumBlowUp | None:
-    """The blow-up the state ``(theta, omega)`` at ``time`` shows, or None if it is sound:
-    a non-finite angle or rate, or a rate beyond :data:`RUNAWAY_RATE`. The message says
-    what to change: a negative damping pumps energy in; otherwise the fixed step is too
-    large for the forces and the integrator is unstable."""
-    bad = ~(np.isfinite(theta) & np.isfinite(omega)) | (np.abs(np.nan_to_num(omega, nan=np.inf)) > RUNAWAY_RATE)
-    if not bad.any():
-        return None
-    k = int(np.flatnonzero(bad)[0])
-    name = character.joints[k].name
-    if params.damping < 0:
-        parameter, advice = "damping", "the damping is negative, which adds energy every step; make it 0 or more"
-    else:
-        parameter, advice = "step", (f"the step of {params.step:g} s is too large for gravity "
-                                     f"{params.g:g} and these accelerations; use a smaller step, more damping "
-                                     "or a weaker gravity")
-    what = "not a finite number" if not (np.isfinite(theta[k]) and np.isfinite(omega[k])) else \
-        f"spinning at {abs(float(omega[k])):.3g} rad/s"
-    return PendulumBlowUp(f"the pendulum '{name}' blew up at {time:.3f} s ({what}): {advice}.",
-                          parameter, time, name)
 
 
 def _decay(damping: float, tau: float) -> float:
@@ -191,34 +98,6 @@ def _divisor(x: FloatArray) -> tuple[FloatArray, FloatArray]:
     return np.where(live, x, 1.0), live.astype(np.float64)
 
 
-def rotate(v: FloatArray, theta: FloatArray | float) -> FloatArray:
-    """R(θ)·v, vectorised over leading axes (θ broadcast against v[..., 0])."""
-    c, s = np.cos(theta), np.sin(theta)
-    return np.stack([c * v[..., 0] + s * v[..., 1], -s * v[..., 0] + c * v[..., 1]], axis=-1)
-
-
-def perp(v: FloatArray) -> FloatArray:
-    """J·v with J(x, y) = (y, −x), i.e. R(π/2)."""
-    return np.stack([v[..., 1], -v[..., 0]], axis=-1)
-
-
-@dataclass(eq=False)
-class PendulumGroup:
-    """Dynamic joints connected through dynamic parents, in pre-order (top first)."""
-
-    joints: list[int]
-    parent: npt.NDArray[np.intp]  # index into ``joints`` or -1
-    mass: FloatArray
-    inertia: FloatArray  # about each joint's own pivot
-    offset: FloatArray  # (n, 2) y0: pivot -> centre of mass, rest pose, scaled
-    ancestor: npt.NDArray[np.bool_]  # (n, n): i is k or an ancestor of k
-    arm: FloatArray  # (n, n, 2) v_ik: i's pivot -> the point of i that carries k (rest, scaled)
-
-    @property
-    def top(self) -> int:
-        return self.joints[0]
-
-
 class PendulumSystem:
     """All dynamic joints of one character and their integration.
 
@@ -230,7 +109,7 @@ class PendulumSystem:
                  limits: Sequence[tuple[float, float] | None] | None = None) -> None:
         self.character = character
         self.params = params or PendulumParams()
-        self.groups = _build_groups(character, self.params)
+        self.groups = build_groups(character, self.params)
         singles = [g for g in self.groups if len(g.joints) == 1]
         self._coupled = [g for g in self.groups if len(g.joints) > 1]
         offset = np.array([g.offset[0] for g in singles]).reshape(-1, 2)
@@ -607,76 +486,8 @@ def _rk4(f: Callable[[FloatArray, FloatArray], FloatArray], th: FloatArray, om: 
             om + tau / 6.0 * (k1w + 2 * k2w + 2 * k3w + k4w))
 
 
-def _position(pos: dict[int, int], parent: int | None) -> int:
-    return -1 if parent is None else pos.get(parent, -1)
-
-
-def _build_groups(character: Character, params: PendulumParams) -> list[PendulumGroup]:
-    joints = character.joints
-    dyn = [j.is_dynamic for j in joints]
-    s = params.length_scale
-    groups: list[PendulumGroup] = []
-    for top, joint in enumerate(joints):
-        if not dyn[top] or (joint.parent is not None and dyn[joint.parent] and params.coupled):
-            continue
-        members = [top]
-        if params.coupled:
-            stack = list(reversed(joint.children))
-            while stack:
-                k = stack.pop()
-                if dyn[k]:
-                    members.append(k)
-                    stack.extend(reversed(joints[k].children))
-        n = len(members)
-        pos = {j: i for i, j in enumerate(members)}
-        parent = np.array([_position(pos, joints[j].parent) for j in members], dtype=np.intp)
-        if n:
-            parent[0] = -1
-        mp = [(joints[j].reference_mass_properties if params.inertia == "reference"
-               else joints[j].mass_properties) for j in members]
-        mass = np.array([p.mass if p else 0.0 for p in mp])
-        offset = np.array([(p.centroid - p.pivot) * s if p else np.zeros(2) for p in mp]).reshape(n, 2)
-        inertia = np.array([p.inertia if p else 0.0 for p in mp])
-        if s != 1.0 and params.inertia == "exact":
-            inertia = inertia * s * s
-        ancestor = np.zeros((n, n), dtype=bool)
-        arm = np.zeros((n, n, 2))
-        for k in range(n):
-            arm[k, k] = offset[k]
-            ancestor[k, k] = True
-            child, i = k, parent[k]
-            while i >= 0:
-                ancestor[i, k] = True
-                arm[i, k] = (joints[members[child]].pivot - joints[members[i]].pivot) * s
-                child, i = i, parent[i]
-        groups.append(PendulumGroup(members, parent, mass, inertia, offset, ancestor, arm))
-    return groups
-
-
-def pivot_accelerations(character: Character, world_angles: FloatArray, world_rates: FloatArray,
-                        world_accels: FloatArray, translation_acc: npt.ArrayLike,
-                        accel_scale: float = 1.0, rotation_accel_scale: float = 1.0) -> FloatArray:
-    """Acceleration (J, 2) of every joint's pivot from the root's translation and the
-    rotation of its ancestors (world angle, rate and acceleration per joint).
-
-    p_n = p_m + R(Θ_m)(c_n − c_m), so p_n'' = p_m'' + Θ_m''·R(Θ_m)·J·v − Θ_m'²·R(Θ_m)·v.
-    """
-    n = len(character.joints)
-    acc = np.zeros((n, 2))
-    acc[0] = np.asarray(translation_acc, dtype=np.float64) * accel_scale
-    c = character.rest_pivots
-    for k in range(1, n):
-        m = int(character.parents[k])
-        acc[k] = acc[m] + rotation_pivot_terms(world_angles[m:m + 1], world_rates[m:m + 1], world_accels[m:m + 1],
-                                               (c[k] - c[m])[None, :], rotation_accel_scale)[0]
-    return acc
-
-
-def rotation_pivot_terms(angles: FloatArray, rates: FloatArray, accels: FloatArray, arms: FloatArray,
-                         scale: float = 1.0) -> FloatArray:
-    """The pivot acceleration an ancestor's rotation adds, for each (ancestor, rest arm v to
-    the pivot): scale·(Θ''·J·R(Θ)·v − Θ'²·R(Θ)·v), the last two terms of
-    p_n'' = p_m'' + Θ_m''·R(Θ_m)·J·v − Θ_m'²·R(Θ_m)·v (:func:`pivot_accelerations`; the
-    document's simulation sums them over each pendulum's ancestors)."""
-    rv = rotate(arms, angles)
-    return np.asarray(scale * (accels[:, None] * perp(rv) - (rates ** 2)[:, None] * rv), dtype=np.float64)
+__all__ = [
+    "INTEGRATORS", "MIN_STEP", "PRESETS", "RUNAWAY_RATE", "FloatArray", "PendulumBlowUp", "PendulumGroup",
+    "PendulumParams", "PendulumSystem", "check_state", "perp", "pivot_accelerations", "rotate",
+    "rotation_pivot_terms", "single_acceleration",
+]

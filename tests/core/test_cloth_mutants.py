@@ -271,3 +271,15 @@ def test_the_solver_iteration_cap_is_max_200_or_8_sqrt_n() -> None:
     springs = np.array([[0, 1]], dtype=np.int64)
     assert implicit_pattern(16, springs, accelerated=True)["maxiter"] == 200
     assert implicit_pattern(4096, springs, accelerated=True)["maxiter"] == 8 * 64
+
+
+def test_a_sphere_pushes_out_only_the_points_inside_its_radius() -> None:
+    """A sphere of radius 0.3 (margin 0) at the origin: a point 0.2 away goes to the surface
+    along its direction, one 0.5 away (inside a unit sphere, outside this one) stays put."""
+    p = ClothParams(ground_enabled=False, collision_margin=0.0)
+    x = np.array([[0.2, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, -0.9]])
+    v = np.zeros_like(x)
+    sphere = (np.zeros(3), 0.3, 0.0, 0.0)
+    collide(p, x, v, [sphere], None, np.zeros(0, dtype=np.int64))
+    assert x[0] == pytest.approx([0.3, 0.0, 0.0], abs=1e-9)
+    assert x[1].tolist() == [0.0, 0.5, 0.0] and x[2].tolist() == [0.0, 0.0, -0.9]
