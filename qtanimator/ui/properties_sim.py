@@ -8,13 +8,16 @@ PENDULUM, SPRING); a preset is one command (``character2d.set_pendulum_preset``,
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import replace
 from typing import Any
 
 from PySide6.QtWidgets import QCheckBox, QComboBox, QDoubleSpinBox, QFormLayout, QGroupBox, QLabel, QWidget
 
+from qtanimator.core.pendulum_params import PRESETS
+from qtanimator.core.spring_joint import SPRING_PRESETS
 from qtanimator.document import character2d
+from qtanimator.document.commands import Command
 from qtanimator.document.parameters import IK, PENDULUM, SPRING
 from qtanimator.ui.properties_form import PanelForm, tool_tip
 
@@ -31,41 +34,18 @@ def ik_group(panel: PanelForm) -> QGroupBox:
 
 def pendulum_group(panel: PanelForm, asset: str) -> QGroupBox:
     doc = panel.ctx.doc
-    from qtanimator.core.pendulum import PRESETS
 
     group = QGroupBox("Pendulums")
     group.setObjectName("pendulumProperties")
     form = QFormLayout(group)
-    preset = QComboBox()
-    preset.setObjectName("pendulumPreset")
-    preset.addItems(list(PRESETS))
-    preset.addItem("custom")
-
-    def current_preset() -> str:
-        params = character2d.pendulum_params(doc, asset)
-        for name, p in PRESETS.items():
-            if p == params:
-                return name
-        return "custom"
-
-    def apply_preset(name: str) -> None:
-        if name in PRESETS and name != current_preset():
-            panel.ctx.push(character2d.set_pendulum_preset(doc, asset, name))
-
-    def refresh_preset() -> None:
-        preset.blockSignals(True)
-        preset.setCurrentText(current_preset())
-        preset.blockSignals(False)
-
-    preset.currentTextChanged.connect(apply_preset)
-    panel.refreshers.append(refresh_preset)
-    panel.editors["preset"] = preset
-    form.addRow("Preset", preset)
+    _preset_row(panel, form, "pendulumPreset", "preset", PRESETS,
+                lambda: character2d.pendulum_params(doc, asset),
+                lambda name: character2d.set_pendulum_preset(doc, asset, name))
     for key, param in PENDULUM.items():
         path = PENDULUM.path(key, asset)
         default = getattr(character2d.pendulum_params(doc, asset), key)
-        editor = panel.parameter_editor(form, param.label, path, default, check=_pendulum_check(panel, asset, key),
-                                        param=param)
+        check = _params_check(lambda: character2d.pendulum_params(doc, asset), key)
+        editor = panel.parameter_editor(form, param.label, path, default, check=check, param=param)
         editor.setToolTip(tool_tip(param))
         # What is shown is the effective value (preset + overrides).
         panel.refreshers.append(_effective_refresher(panel, editor, asset, key))
@@ -86,18 +66,46 @@ def pendulum_group(panel: PanelForm, asset: str) -> QGroupBox:
     return group
 
 
-def _pendulum_check(panel: PanelForm, asset: str, name: str) -> Callable[[Any], str | None]:
-    """The pendulum parameters' own validation (``PendulumParams``) as a field check."""
-    doc = panel.ctx.doc
-
+def _params_check(params: Callable[[], Any], name: str) -> Callable[[Any], str | None]:
+    """The constants' own validation (``PendulumParams``, ``SpringParams``) as a field check:
+    the sentence of the error ``name = value`` raises, or None."""
     def check(value: Any) -> str | None:
         try:
-            replace(character2d.pendulum_params(doc, asset), **{name: value})
+            replace(params(), **{name: value})
         except (TypeError, ValueError) as exc:
             return str(exc)
         return None
 
     return check
+
+
+def _preset_row(panel: PanelForm, form: QFormLayout, object_name: str, editor_key: str,
+                presets: Mapping[str, Any], params: Callable[[], Any],
+                command: Callable[[str], Command]) -> QComboBox:
+    """A "Preset" row: the preset the current constants equal ("custom" when none); choosing
+    one pushes ``command(name)`` (one undo step)."""
+    preset = QComboBox()
+    preset.setObjectName(object_name)
+    preset.addItems([*presets, "custom"])
+
+    def current() -> str:
+        now = params()
+        return next((name for name, p in presets.items() if p == now), "custom")
+
+    def apply(name: str) -> None:
+        if name in presets and name != current():
+            panel.ctx.push(command(name))
+
+    def refresh() -> None:
+        preset.blockSignals(True)
+        preset.setCurrentText(current())
+        preset.blockSignals(False)
+
+    preset.currentTextChanged.connect(apply)
+    panel.refreshers.append(refresh)
+    panel.editors[editor_key] = preset
+    form.addRow("Preset", preset)
+    return preset
 
 
 def _effective_refresher(panel: PanelForm, editor: QWidget, asset: str, name: str) -> Callable[[], None]:
@@ -121,43 +129,18 @@ def spring_group(panel: PanelForm, asset: str) -> QGroupBox:
     """The character's spring constants: a preset and each value (document parameters
     ``<asset>.spring.<name>``)."""
     doc = panel.ctx.doc
-    from qtanimator.core.spring_joint import SPRING_PRESETS
 
     group = QGroupBox("Springs")
     group.setObjectName("springProperties")
     form = QFormLayout(group)
-    preset = QComboBox()
-    preset.setObjectName("springPreset")
-    preset.addItems([*SPRING_PRESETS, "custom"])
-
-    def current_preset() -> str:
-        params = character2d.spring_params(doc, asset)
-        return next((name for name, p in SPRING_PRESETS.items() if p == params), "custom")
-
-    def apply_preset(name: str) -> None:
-        if name in SPRING_PRESETS and name != current_preset():
-            panel.ctx.push(character2d.set_spring_preset(doc, asset, name))
-
-    def refresh_preset() -> None:
-        preset.blockSignals(True)
-        preset.setCurrentText(current_preset())
-        preset.blockSignals(False)
-
-    preset.currentTextChanged.connect(apply_preset)
-    panel.refreshers.append(refresh_preset)
-    panel.editors["spring_preset"] = preset
-    form.addRow("Preset", preset)
+    _preset_row(panel, form, "springPreset", "spring_preset", SPRING_PRESETS,
+                lambda: character2d.spring_params(doc, asset),
+                lambda name: character2d.set_spring_preset(doc, asset, name))
     for key, param in SPRING.items():
         path = SPRING.path(key, asset)
 
-        def check(value: Any, name: str = key) -> str | None:
-            try:
-                replace(character2d.spring_params(doc, asset), **{name: value})
-            except (TypeError, ValueError) as exc:
-                return str(exc)
-            return None
-
         value = getattr(character2d.spring_params(doc, asset), key)
+        check = _params_check(lambda: character2d.spring_params(doc, asset), key)
         editor = panel.parameter_editor(form, param.label, path, value, check=check, param=param)
         editor.setToolTip(tool_tip(param))
 
