@@ -104,3 +104,32 @@ def test_sampling_is_repeatable(mutation) -> None:  # type: ignore[no-untyped-de
 def test_wilson_interval(mutation) -> None:  # type: ignore[no-untyped-def]
     lo, hi = mutation.wilson(90, 100)
     assert 0.82 < lo < 0.84 and 0.94 < hi < 0.95
+
+
+def test_overload_stubs_are_not_mutated(mutation) -> None:  # type: ignore[no-untyped-def]
+    src = (
+        "from typing import overload\n"
+        "class C:\n"
+        "    @overload\n"
+        "    def f(self, x: int = 0) -> int: ...\n"
+        "    @overload\n"
+        "    def f(self, x: str = '') -> str: ...\n"
+        "    def f(self, x=1):\n"
+        "        return x\n"
+    )
+    sites = mutation.mutation_sites(src)
+    # Only the real body's default (1 -> 2) and its return are sites; the stubs' defaults are not.
+    assert sorted(m.line for m in sites) == [7, 8]
+
+
+def test_rank_puts_the_file_that_calls_a_rare_name_first(mutation, tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    monkeypatch.setattr(mutation, "REPO", tmp_path)
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "pkg" / "things.py").write_text("class Common: ...\ndef rare_rule(): ...\n")
+    (tmp_path / "tests" / "test_a.py").write_text("from pkg.things import Common\nCommon()\n" + "#" * 10)
+    (tmp_path / "tests" / "test_b.py").write_text("from pkg.things import Common, rare_rule\n" + "#" * 500)
+    (tmp_path / "tests" / "test_c.py").write_text("from pkg.things import Common\n")
+    order = mutation.rank_tests("pkg/things.py", ["tests/test_a.py", "tests/test_b.py", "tests/test_c.py"])
+    # test_b is the largest file but the only one naming rare_rule; then smallest first.
+    assert order == ["tests/test_b.py", "tests/test_c.py", "tests/test_a.py"]

@@ -46,6 +46,7 @@ import json
 import math
 import os
 import random
+import re
 import shutil
 import signal
 import subprocess
@@ -140,6 +141,10 @@ class _SiteFinder(ast.NodeVisitor):
     # --- what is skipped ---------------------------------------------------------------------
     def visit_FunctionDef(self, node: ast.FunctionDef | ast.AsyncFunctionDef) -> None:
         # Decorators, annotations and the docstring are skipped; defaults and the body are not.
+        # An ``@overload`` stub is never run (it is a type annotation): skipped whole.
+        if any((isinstance(d, ast.Name) and d.id == "overload")
+               or (isinstance(d, ast.Attribute) and d.attr == "overload") for d in node.decorator_list):
+            return
         for default in [*node.args.defaults, *(d for d in node.args.kw_defaults if d is not None)]:
             self.visit(default)
         self._returns.append(node.returns)
@@ -380,19 +385,59 @@ def tests_for_module(path: str, test_files: Iterable[Path], package_files: Itera
     return sorted(str(t.relative_to(REPO)) for t, names in tests.items() if names & (wanted | importers))
 
 
+def defined_names(path: Path) -> frozenset[str]:
+    """The names ``path`` defines at module level and in its classes (functions, classes,
+    constants, methods), private ones included."""
+    try:
+        tree = ast.parse(path.read_text(encoding="utf-8"))
+    except (SyntaxError, UnicodeDecodeError, OSError):
+        return frozenset()
+    names: set[str] = set()
+    bodies = [tree.body]
+    while bodies:
+        for node in bodies.pop():
+            if isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef, ast.ClassDef)):
+                names.add(node.name)
+                if isinstance(node, ast.ClassDef):
+                    bodies.append(node.body)
+            elif isinstance(node, (ast.Assign, ast.AnnAssign)):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                names.update(t.id for t in targets if isinstance(t, ast.Name))
+    return frozenset(n for n in names if len(n.strip("_")) > 2 and not (n.startswith("__") and n.endswith("__")))
+
+
+def reference_weight(names: Iterable[str], tests: list[str]) -> dict[str, float]:
+    """How much of ``names`` each test file mentions, each name weighted by 1 / (the number of
+    ``tests`` that mention it): a file that calls the rare function a mutant sits in ranks above
+    one that only mentions the module's common types."""
+    words = {t: frozenset(_WORD.findall((REPO / t).read_text(encoding="utf-8", errors="replace"))) for t in tests}
+    weight = dict.fromkeys(tests, 0.0)
+    for name in names:
+        holders = [t for t in tests if name in words[t]]
+        for t in holders:
+            weight[t] += 1.0 / len(holders)
+    return weight
+
+
+_WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
+
+
 def rank_tests(path: str, tests: list[str]) -> list[str]:
     """``tests`` in the order to try them for ``path``: files named after the module (or its
-    package, for ``pkg/__init__.py`` and the modules of a subpackage) first, then those of the
-    same area (tests/core for qtanimator/core), smaller files first."""
+    package, for ``pkg/__init__.py`` and the modules of a subpackage) first; then, within each
+    of those tiers, the files that mention more of the module's own names (weighted by how few
+    files mention each, :func:`reference_weight`), then those of the same area (tests/core for
+    qtanimator/core), smaller files first."""
     p = Path(path)
     stem = p.parent.name if p.name == "__init__.py" else p.stem.lstrip("_")
     package = p.parent.name
     area = p.parts[1] if len(p.parts) > 2 else ""
+    weight = reference_weight(defined_names(REPO / path), tests)
 
-    def key(t: str) -> tuple[int, int, int]:
+    def key(t: str) -> tuple[int, float, int, int]:
         test = Path(t)
         own = 0 if stem in test.stem else 1 if stem.split("_")[0] in test.stem else 2 if package in test.stem else 3
-        return (own, 0 if area in test.parts else 1, (REPO / t).stat().st_size)
+        return (min(own, 2), -round(weight[t], 3), 0 if area in test.parts else 1, (REPO / t).stat().st_size)
 
     return sorted(tests, key=key)
 
@@ -569,7 +614,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--timeout", type=float, default=None, help="seconds per mutant (default 3x baseline + 5)")
     parser.add_argument("--max-file-seconds", type=float, default=20.0,
                         help="leave out test files slower than this in the baseline")
-    parser.add_argument("--max-test-files", type=int, default=4, help="at most this many test files per module")
+    parser.add_argument("--max-test-files", type=int, default=10, help="at most this many test files per module")
     parser.add_argument("--budget-minutes", type=float, default=None, help="stop starting mutants after this")
     parser.add_argument("--out", default=None, help="report file (default: print)")
     parser.add_argument("--work", default=str(WORK), help="folder for the private copies of the repository")
