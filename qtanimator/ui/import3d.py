@@ -18,11 +18,12 @@ from typing import Any
 
 from PySide6.QtCore import QTimer
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QFileDialog, QMessageBox, QPushButton
+from PySide6.QtWidgets import QMessageBox, QPushButton
 
 from qtanimator.document.character3d import ASSET_KIND, set_fps_command
 from qtanimator.document.import3d import SUFFIXES, export_gltf, import_file, target_character
 from qtanimator.formats.errors import FormatError
+from qtanimator.ui.app_settings import ask_export_path
 
 GLTF_FILTER = "glTF binary (*.glb)"
 #: How long the status-bar offer to take an imported clip's frame rate stays (ms).
@@ -138,13 +139,9 @@ def export_gltf_dialog(window: Any) -> None:
     if aid is None:
         export_gltf_to(window, "", None)  # explains why
         return
-    start = str(Path(window._last_dir()) / f"{aid}.glb")
-    path, _ = QFileDialog.getSaveFileName(window, "Export glTF", start, GLTF_FILTER)
-    if not path:
-        return
-    if not Path(path).suffix:
-        path += ".glb"
-    export_gltf_to(window, path, aid)
+    path = ask_export_path(window, "Export glTF", aid, ".glb", GLTF_FILTER)
+    if path:
+        export_gltf_to(window, path, aid)
 
 
 def install(window: Any) -> None:

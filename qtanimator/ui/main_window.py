@@ -14,7 +14,7 @@ from collections.abc import Callable, Collection
 from pathlib import Path
 
 import shiboken6
-from PySide6.QtCore import QByteArray, QSettings, Qt
+from PySide6.QtCore import QByteArray, Qt
 from PySide6.QtGui import QAction, QCloseEvent, QDragEnterEvent, QDropEvent, QIcon, QKeySequence
 from PySide6.QtWidgets import (
     QApplication,
@@ -30,18 +30,20 @@ from PySide6.QtWidgets import (
 
 from qtanimator import __version__
 from qtanimator.core.cloth_kernels import warm_up
-from qtanimator.document.asset_files import ASSETS_FOLDER, FileRef, collect_assets, file_refs, is_inside
+from qtanimator.document.asset_files import ASSETS_FOLDER, file_refs, is_inside
 from qtanimator.document.document import Document
-from qtanimator.document.io import Relink, open_document_relinked, save_document
+from qtanimator.document.io import open_document_relinked, save_document
 from qtanimator.formats.errors import FormatError
 from qtanimator.paths import app_icon_path
 from qtanimator.ui import errors, help_viewer
+from qtanimator.ui.app_settings import last_dir, settings
+from qtanimator.ui.asset_collect import collect_into, locate_missing_file, tell_relinked
 from qtanimator.ui.context import EditorContext
+from qtanimator.ui.recent_files import RecentFiles
 from qtanimator.ui.widgets import install_dock_behaviour
 
 PROJECT_SUFFIX = ".qtanim"
 PROJECT_FILTER = "qtanimator projects (*.qtanim *.json)"
-MAX_RECENT = 10
 
 #: Editor modules installed into every window, in order. Each has ``install(window)``.
 EDITOR_MODULES: list[str] = [
@@ -75,14 +77,6 @@ def redo_shortcuts() -> list[QKeySequence]:
 
 #: Openers for files that are not projects, by lower-case suffix; editors register them.
 Opener = Callable[["MainWindow", Path], None]
-
-
-def settings() -> QSettings:
-    """The program's settings; tests point QTANIMATOR_SETTINGS_DIR at a temporary folder."""
-    folder = os.environ.get("QTANIMATOR_SETTINGS_DIR")
-    if folder:
-        return QSettings(str(Path(folder) / "qtanimator.ini"), QSettings.Format.IniFormat)
-    return QSettings("qtanimator", "qtanimator")
 
 
 class MainWindow(QMainWindow):
@@ -182,7 +176,7 @@ class MainWindow(QMainWindow):
         self.file_menu.addSeparator()
         self.export_separator = self.file_menu.addSeparator()
         self.file_menu.addAction(self.action_quit)
-        self._refresh_recent_menu()
+        self.recent = RecentFiles(self.recent_menu, self.open_with_prompt)
 
         stack = self.ctx.undo_stack
         self.action_undo = stack.createUndoAction(self, "&Undo")
@@ -278,7 +272,7 @@ class MainWindow(QMainWindow):
     def open_dialog(self) -> None:
         suffixes = " ".join(f"*{s}" for s in sorted(self.openers))
         filters = f"All supported ({'*.qtanim *.json ' + suffixes});;{PROJECT_FILTER};;All files (*)"
-        path, _ = QFileDialog.getOpenFileName(self, "Open", self._last_dir(), filters)
+        path, _ = QFileDialog.getOpenFileName(self, "Open", last_dir(), filters)
         if path:
             self.open_with_prompt(path)
 
@@ -299,25 +293,25 @@ class MainWindow(QMainWindow):
             else:
                 raise FormatError("qtanimator does not know this kind of file.", p)
         except FormatError as exc:
-            self._forget_if_gone(p)
+            self.recent.forget_if_gone(p)
             self.show_error("Cannot open file", str(exc))
             return False
         except OSError as exc:
-            self._forget_if_gone(p)
+            self.recent.forget_if_gone(p)
             self.show_error("Cannot open file", f"{p.name}: {exc.strerror or exc}")
             return False
-        self._remember_recent(p)
+        self.recent.remember(p)
         self._update_title()
         return True
 
     def open_project(self, p: Path) -> None:
         """Replace the document with the project ``p`` (FormatError / OSError: unchanged)."""
-        doc, relinks = open_document_relinked(p, self.locate_missing_file)
+        doc, relinks = open_document_relinked(p, lambda ref: locate_missing_file(self, ref))
         self._relinked_unsaved = bool(relinks)
         self.ctx.replace_document(doc)
         self.restore_view_state()
         if relinks:
-            self._tell_relinked(relinks)
+            tell_relinked(self, relinks)
 
     def save(self) -> bool:
         if self.doc.path is None:
@@ -326,7 +320,7 @@ class MainWindow(QMainWindow):
 
     def save_as(self) -> bool:
         """Ask where (and whether to collect the assets there), then save."""
-        start = self.doc.path or str(Path(self._last_dir()) / f"untitled{PROJECT_SUFFIX}")
+        start = self.doc.path or str(Path(last_dir()) / f"untitled{PROJECT_SUFFIX}")
         path, collect = self.ask_save_path(start)
         if not path:
             return False
@@ -383,7 +377,7 @@ class MainWindow(QMainWindow):
             self.show_error("Cannot save", f"Cannot make the folder {target.parent} for {target.name}: "
                             f"{exc.strerror or exc}.")
             return False
-        if collect and not self._collect_into(target.parent):
+        if collect and not collect_into(self, self.ctx, target.parent):
             return False
         try:
             self.prepare_save()
@@ -397,7 +391,7 @@ class MainWindow(QMainWindow):
             return False
         self.ctx.undo_stack.setClean()
         self._relinked_unsaved = False
-        self._remember_recent(target)
+        self.recent.remember(target)
         self._update_title()
         return True
 
@@ -407,8 +401,7 @@ class MainWindow(QMainWindow):
         ``assets/`` and point the project at the copies (one undo step). An untitled
         project is saved first (Save As, with collecting ticked)."""
         if self.doc.path is None:
-            start = str(Path(self._last_dir()) / f"untitled{PROJECT_SUFFIX}")
-            path, _collect = self.ask_save_path(start)
+            path, _collect = self.ask_save_path(str(Path(last_dir()) / f"untitled{PROJECT_SUFFIX}"))
             if not path:
                 return False
             if not Path(path).suffix:
@@ -417,83 +410,12 @@ class MainWindow(QMainWindow):
         folder = Path(self.doc.path).parent
         outside = [r for r in file_refs(self.doc.assets.values()) if not is_inside(r.path, folder)]
         if not outside:
-            QMessageBox.information(self, "Collect Assets",
-                                    f"Every file the project uses is already in {folder}.")
+            QMessageBox.information(self, "Collect Assets", f"Every file the project uses is already in {folder}.")
             return True
-        return self._collect_into(folder)
-
-    def _collect_into(self, folder: Path) -> bool:
-        try:
-            result = collect_assets(self.doc, folder)
-        except OSError as exc:
-            where = f" ({exc.filename})" if exc.filename else ""
-            self.show_error("Cannot collect assets", f"Copying into {folder / ASSETS_FOLDER} failed{where}: "
-                            f"{exc.strerror or exc}. The project still uses the files where they were.")
-            return False
-        if result.command is not None:
-            self.ctx.push(result.command)
-        missing = [r for r in file_refs(self.doc.assets.values()) if not Path(r.path).exists()]
-        if missing:
-            names = ", ".join(sorted({Path(r.path).name for r in missing}))
-            QMessageBox.warning(self, "Collect Assets", f"These files are missing and were not copied: {names}.")
-        return True
-
-    def locate_missing_file(self, ref: FileRef) -> str | None:
-        """Asked while opening a project whose file ``ref`` is not where it was and not found
-        beside the project: a file dialog to point at it (None when cancelled)."""
-        old = Path(ref.path)
-        title = f"Locate {old.name} (missing, used by {ref.asset_id})"
-        start = self._last_dir()
-        if not old.suffix:  # a folder of SVG characters
-            chosen = QFileDialog.getExistingDirectory(self, title, start)
-        else:
-            chosen, _ = QFileDialog.getOpenFileName(self, title, start, f"{old.name} (*{old.suffix});;All files (*)")
-        return chosen or None
-
-    def _tell_relinked(self, relinks: list[Relink]) -> None:
-        lines = [f"{r.ref.asset_id}: {Path(r.ref.path).name} → {r.new_path}"
-                 + ("" if r.how == "chosen" else " (found beside the project)") for r in relinks]
-        QMessageBox.information(
-            self, "Assets found at new places",
-            "Some files of this project had moved; it now uses:\n\n" + "\n".join(lines)
-            + "\n\nSave the project to keep these locations.")
-
-    def _last_dir(self) -> str:
-        return str(settings().value("lastDir", str(Path.home())))
+        return collect_into(self, self.ctx, folder)
 
     def recent_files(self) -> list[str]:
-        value = settings().value("recentFiles", [])
-        if isinstance(value, str):
-            value = [value]
-        if not isinstance(value, (list, tuple)):
-            return []  # nothing stored (an empty list reads back as None)
-        return [str(v) for v in value]
-
-    def _remember_recent(self, path: Path) -> None:
-        s = settings()
-        full = str(path.resolve())
-        recent = [full] + [r for r in self.recent_files() if r != full]
-        s.setValue("recentFiles", recent[:MAX_RECENT])
-        s.setValue("lastDir", str(path.resolve().parent))
-        self._refresh_recent_menu()
-
-    def _forget_if_gone(self, path: Path) -> None:
-        """A recent file that no longer exists leaves the Recent menu."""
-        if path.exists():
-            return
-        full = str(path.resolve())
-        recent = self.recent_files()
-        if full in recent:
-            settings().setValue("recentFiles", [r for r in recent if r != full])
-            self._refresh_recent_menu()
-
-    def _refresh_recent_menu(self) -> None:
-        self.recent_menu.clear()
-        for path in self.recent_files():
-            action = self.recent_menu.addAction(Path(path).name)
-            action.setToolTip(path)
-            action.triggered.connect(lambda _c=False, p=path: self.open_with_prompt(p))
-        self.recent_menu.setEnabled(bool(self.recent_files()))
+        return self.recent.paths()
 
     def _on_clean_changed(self, _clean: bool) -> None:
         if shiboken6.isValid(self):  # the stack is cleared while the window is destroyed

@@ -54,6 +54,7 @@ from PySide6.QtGui import QAction, QColor, QKeySequence
 from PySide6.QtWidgets import QCheckBox, QColorDialog, QLabel, QSpinBox, QToolBar, QToolButton, QVBoxLayout, QWidget
 
 from qtanimator.document import character2d
+from qtanimator.ui.app_settings import settings
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.rig_canvas import BACKGROUND, LIMIT_WEDGE_COLOR, LIMIT_WEDGE_RADIUS_PX, RigCanvas
 from qtanimator.ui.rig_sprites import SCENE_LIMIT, CharacterItem, JointSprites
@@ -232,8 +233,6 @@ def install(window: MainWindow) -> None:
 def _restore_editor_settings(editor: RigEditor) -> None:
     """The onion skin's counts and step are user preferences, kept in the program's settings
     (the IK mode is not: a toggle that silently persisted would surprise)."""
-    from qtanimator.ui.main_window import settings
-
     s = settings()
 
     def stored(key: str, default: int) -> int:

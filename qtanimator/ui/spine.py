@@ -24,6 +24,7 @@ from qtanimator.document.character2d import ASSET_KIND, character_assets
 from qtanimator.document.spine_import import spine_import_command
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.spine import looks_like_spine
+from qtanimator.ui.app_settings import ask_export_path, last_dir
 
 SPINE_FILTER = "Spine JSON (*.json)"
 
@@ -75,7 +76,7 @@ def open_json(window: Any, path: Path) -> None:
 
 
 def import_spine_dialog(window: Any) -> None:
-    path, _ = QFileDialog.getOpenFileName(window, "Import Spine Animation", window._last_dir(), SPINE_FILTER)
+    path, _ = QFileDialog.getOpenFileName(window, "Import Spine Animation", last_dir(), SPINE_FILTER)
     if not path:
         return
     try:
@@ -108,13 +109,9 @@ def export_spine_dialog(window: Any) -> None:
     if aid is None:
         export_spine_to(window, "", None)  # explains why
         return
-    start = str(Path(window._last_dir()) / f"{aid}.json")
-    path, _ = QFileDialog.getSaveFileName(window, "Export Spine", start, SPINE_FILTER)
-    if not path:
-        return
-    if not Path(path).suffix:
-        path += ".json"
-    export_spine_to(window, path, aid)
+    path = ask_export_path(window, "Export Spine", aid, ".json", SPINE_FILTER)
+    if path:
+        export_spine_to(window, path, aid)
 
 
 def install(window: Any) -> None:
