@@ -133,3 +133,58 @@ def test_rank_puts_the_file_that_calls_a_rare_name_first(mutation, tmp_path: Pat
     order = mutation.rank_tests("pkg/things.py", ["tests/test_a.py", "tests/test_b.py", "tests/test_c.py"])
     # test_b is the largest file but the only one naming rare_rule; then smallest first.
     assert order == ["tests/test_b.py", "tests/test_c.py", "tests/test_a.py"]
+
+
+def test_line_trace_maps_each_test_to_the_lines_it_runs(tmp_path: Path) -> None:
+    """tools/mutation_trace.py: a pytest run over two tests of a tiny module records, per
+    test, the module's lines it ran, and apart the lines run at import."""
+    import json
+    import os
+    import subprocess
+
+    (tmp_path / "tiny.py").write_text(textwrap.dedent("""\
+        LIMIT = 3
+
+        def small(x):
+            return x + 1
+
+        def big(x):
+            if x > LIMIT:
+                return x * 2
+            return x
+        """), encoding="utf-8")
+    (tmp_path / "test_tiny.py").write_text(textwrap.dedent("""\
+        import tiny
+
+        def test_small():
+            assert tiny.small(1) == 2
+
+        def test_big():
+            assert tiny.big(5) == 10
+        """), encoding="utf-8")
+    (tmp_path / "pytest.ini").write_text("[pytest]\n", encoding="utf-8")
+    out = tmp_path / "trace.json"
+    env = dict(os.environ, PYTHONPATH=f"{tmp_path}{os.pathsep}{TOOL.parent}",
+               MUTATION_TRACE_FILE=str(tmp_path / "tiny.py"), MUTATION_TRACE_OUT=str(out))
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "mutation_trace",
+                           "test_tiny.py"], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    data = json.loads(out.read_text(encoding="utf-8"))
+    assert data["order"] == ["test_tiny.py::test_small", "test_tiny.py::test_big"]
+    assert set(data["lines"]["test_tiny.py::test_small"]) == {3, 4}
+    assert set(data["lines"]["test_tiny.py::test_big"]) == {6, 7, 8}  # not 9: x > LIMIT
+    assert {1, 3, 6} <= set(data["lines"][""])  # import: the constant and the two defs
+
+
+def test_a_mutant_runs_only_the_tests_that_ran_its_lines(mutation) -> None:  # type: ignore[no-untyped-def]
+    source = "LIMIT = 3\n\ndef big(x):\n    if x > LIMIT:\n        return (x\n                * 2)\n    return x\n"
+    (mult, *_) = [m for m in mutation.mutation_sites(source, "tiny.py") if m.operator == "arith"]
+    number = [m for m in mutation.mutation_sites(source, "tiny.py") if m.before == "3"][0]
+    plan = mutation.ModulePlan(path="tiny.py", sites=0, mutants=[], tests=["t.py"], source=source,
+                               order=["t.py::a", "t.py::b"],
+                               lines={"t.py::a": frozenset({3, 4, 7}), "t.py::b": frozenset({3, 4, 6})},
+                               outside=frozenset({1, 3}))
+    assert plan.tests_for(mult) == ["t.py::b"]  # the product spans lines 5-6; b ran line 6
+    assert plan.tests_for(number) is None  # LIMIT = 3 runs at import: the whole files
+    plan.lines = {"t.py::a": frozenset({3, 4, 7}), "t.py::b": frozenset({3, 4, 7})}
+    assert plan.tests_for(mult) == []  # nobody runs it: it survives unrun

@@ -422,6 +422,15 @@ def reference_weight(names: Iterable[str], tests: list[str]) -> dict[str, float]
 _WORD = re.compile(r"[A-Za-z_][A-Za-z0-9_]*")
 
 
+def own_tier(path: str, test: str) -> int:
+    """0: ``test`` is named after the module (test_<module>*.py); 1: after the first word of
+    its name; 2: after its package; 3: none of these."""
+    p = Path(path)
+    stem = p.parent.name if p.name == "__init__.py" else p.stem.lstrip("_")
+    name = Path(test).stem
+    return 0 if stem in name else 1 if stem.split("_")[0] in name else 2 if p.parent.name in name else 3
+
+
 def rank_tests(path: str, tests: list[str]) -> list[str]:
     """``tests`` in the order to try them for ``path``: files named after the module (or its
     package, for ``pkg/__init__.py`` and the modules of a subpackage) first; then, within each
@@ -429,15 +438,12 @@ def rank_tests(path: str, tests: list[str]) -> list[str]:
     files mention each, :func:`reference_weight`), then those of the same area (tests/core for
     qtanimator/core), smaller files first."""
     p = Path(path)
-    stem = p.parent.name if p.name == "__init__.py" else p.stem.lstrip("_")
-    package = p.parent.name
     area = p.parts[1] if len(p.parts) > 2 else ""
     weight = reference_weight(defined_names(REPO / path), tests)
 
     def key(t: str) -> tuple[int, float, int, int]:
-        test = Path(t)
-        own = 0 if stem in test.stem else 1 if stem.split("_")[0] in test.stem else 2 if package in test.stem else 3
-        return (min(own, 2), -round(weight[t], 3), 0 if area in test.parts else 1, (REPO / t).stat().st_size)
+        return (min(own_tier(path, t), 2), -round(weight[t], 3), 0 if area in Path(t).parts else 1,
+                (REPO / t).stat().st_size)
 
     return sorted(tests, key=key)
 
@@ -477,12 +483,22 @@ def _env(copy: Path) -> dict[str, str]:
     return env
 
 
-def run_tests(copy: Path, tests: list[str], timeout: float) -> tuple[str, float, str]:
-    """Run ``tests`` in ``copy``: (outcome, seconds, output tail); outcome passed/failed/timeout/error."""
+def run_tests(copy: Path, tests: list[str], timeout: float,
+              trace: tuple[Path, Path] | None = None) -> tuple[str, float, str]:
+    """Run ``tests`` (files or node ids) in ``copy``: (outcome, seconds, output tail); outcome
+    passed/failed/timeout/error, or ``notfound`` when pytest could not find a node id or
+    collected nothing. ``trace`` = (module file, JSON out): record which tests run which of
+    the module's lines (tools/mutation_trace.py)."""
     cmd = ["nice", "-n", "19", sys.executable, "-m", "pytest", "-x", "-q", "-p", "no:cacheprovider",
            "-m", "not slow", "-o", "timeout=0", *tests]
+    env = _env(copy)
+    if trace is not None:
+        cmd[cmd.index("-x")] = "-p"
+        cmd.insert(cmd.index("-p") + 1, "mutation_trace")
+        env.update(PYTHONPATH=f"{copy}{os.pathsep}{copy / 'tools'}", MUTATION_TRACE_FILE=str(trace[0]),
+                   MUTATION_TRACE_OUT=str(trace[1]))
     start = time.monotonic()
-    proc = subprocess.Popen(cmd, cwd=copy, env=_env(copy), stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
+    proc = subprocess.Popen(cmd, cwd=copy, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT,
                             start_new_session=True, text=True)
     try:
         out, _ = proc.communicate(timeout=timeout)
@@ -493,6 +509,8 @@ def run_tests(copy: Path, tests: list[str], timeout: float) -> tuple[str, float,
     seconds = time.monotonic() - start
     if proc.returncode == 0:
         return "passed", seconds, out[-2000:]
+    if proc.returncode in (4, 5):  # usage error (a node id not found) / nothing collected
+        return "notfound", seconds, out[-2000:]
     if proc.returncode == 2 or "error during collection" in out or "errors during collection" in out:
         return "error", seconds, out[-2000:]
     return "failed", seconds, out[-2000:]
@@ -508,6 +526,23 @@ class ModulePlan:
     baseline_s: float = 0.0
     timeout_s: float = 0.0
     skipped: str = ""
+    #: ``--select lines``: the test node ids in the order they ran, the lines each ran, and
+    #: the lines run outside any test (import, collection).
+    order: list[str] = dataclasses.field(default_factory=list)
+    lines: dict[str, frozenset[int]] = dataclasses.field(default_factory=dict)
+    outside: frozenset[int] = frozenset()
+
+    def tests_for(self, mutant: Mutant) -> list[str] | None:
+        """The tests to run for ``mutant``: the node ids that ran one of its lines ([] when
+        none did), or None for the whole files (no line map, or a line run at import)."""
+        if not self.order:
+            return None
+        first = mutant.line
+        last = first + self.source.encode("utf-8")[mutant.start:mutant.end].count(b"\n")
+        span = set(range(first, last + 1))
+        if span & self.outside:
+            return None
+        return [t for t in self.order if span & self.lines.get(t, frozenset())]
 
 
 @dataclasses.dataclass
@@ -515,6 +550,7 @@ class Result:
     mutant: Mutant
     outcome: str   # killed / survived / timeout / error
     seconds: float
+    tests: int = -1  # node ids run (--select lines); -1: the whole files
 
 
 def wilson(k: int, n: int, z: float = 1.96) -> tuple[float, float]:
@@ -539,7 +575,7 @@ def report(plans: list[ModulePlan], results: list[Result], args: argparse.Namesp
         f"wall: {(time.monotonic() - started) / 60:.1f} min",
         f"command: python tools/mutation.py {' '.join(args.argv)}",
         f"modules: {', '.join(args.modules)}   per-module: {args.per_module}   seed: {args.seed}   "
-        f"jobs: {args.jobs}   numba: {args.numba}   tree: {args.tree}",
+        f"jobs: {args.jobs}   numba: {args.numba}   select: {args.select}   tree: {args.tree}",
         "killed = the module's tests fail; timeout and import/collection error also count as killed.",
         "",
         f"{'module':44} {'sites':>5} {'run':>4} {'killed':>6} {'surv':>4} {'tmo':>3} {'err':>3} {'score':>6}"
@@ -586,7 +622,7 @@ def report(plans: list[ModulePlan], results: list[Result], args: argparse.Namesp
     lines += ["", "Survivors (the tests still pass with this change):"]
     for r in sorted(results, key=lambda r: (r.mutant.path, r.mutant.start)):
         if r.outcome == "survived":
-            lines.append("  " + r.mutant.describe())
+            lines.append("  " + r.mutant.describe() + ("   (no test runs this line)" if r.tests == 0 else ""))
     lines += ["", "Timeouts and import errors (counted as killed):"]
     for r in sorted(results, key=lambda r: (r.mutant.path, r.mutant.start)):
         if r.outcome in ("timeout", "error"):
@@ -621,6 +657,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--numba", choices=["off", "python"], default="off",
                         help="off: QTANIMATOR_NO_NUMBA=1 (numpy); python: NUMBA_DISABLE_JIT=1 (kernels in Python)")
     parser.add_argument("--list", action="store_true", help="only list the sampled mutants")
+    parser.add_argument("--select", choices=["lines", "files"], default="lines",
+                        help="lines: run only the tests that ran the mutated lines in the (traced) baseline; "
+                             "files: the module's whole test files for every mutant")
     args = parser.parse_args(argv)
     args.argv = sys.argv[1:] if argv is None else argv
     global NUMBA_MODE
@@ -675,22 +714,33 @@ def main(argv: list[str] | None = None) -> int:
             if len(usable) >= args.max_test_files:
                 break
             if t not in file_times:
-                outcome, secs, _ = run_tests(copies[0], [t], timeout=args.max_file_seconds + 10)
+                limit = 600 if own_tier(plan.path, t) == 0 else args.max_file_seconds + 10
+                outcome, secs, _ = run_tests(copies[0], [t], timeout=limit)
                 file_times[t] = (outcome, secs)
                 print(f"baseline {t}: {outcome} {secs:.1f}s", flush=True)
-            if file_times[t][0] == "passed" and file_times[t][1] <= args.max_file_seconds:
+            own = own_tier(plan.path, t) == 0  # named after the module: kept however slow
+            if file_times[t][0] == "passed" and (own or file_times[t][1] <= args.max_file_seconds):
                 usable.append(t)
         plan.tests = usable
         if not plan.tests:
             plan.skipped = "(no fast passing tests import it)"
             plan.mutants = []
             continue
-        outcome, secs, out = run_tests(copies[0], plan.tests, timeout=600)
+        # The baseline (with --select lines, traced: which tests run which of the module's lines).
+        trace_out = work_dir / f"trace-{plan.path.replace('/', '.')}.json"
+        trace_out.unlink(missing_ok=True)
+        trace = (copies[0] / plan.path, trace_out) if args.select == "lines" else None
+        outcome, secs, out = run_tests(copies[0], plan.tests, timeout=600, trace=trace)
         if outcome != "passed":
             plan.skipped = f"(baseline {outcome})"
             plan.mutants = []
             print(f"baseline of {plan.path} {outcome}:\n{out}", flush=True)
             continue
+        if trace is not None:
+            data = json.loads(trace_out.read_text(encoding="utf-8"))
+            plan.lines = {k: frozenset(v) for k, v in data["lines"].items() if k}
+            plan.outside = frozenset(data["lines"].get("", []))
+            plan.order = list(dict.fromkeys(data["order"]))
         plan.baseline_s = secs
         plan.timeout_s = args.timeout if args.timeout else 3 * secs + 5
         print(f"baseline {plan.path}: {secs:.1f}s with {len(plan.tests)} files, "
@@ -710,17 +760,24 @@ def main(argv: list[str] | None = None) -> int:
             Path(args.out).write_text(text, encoding="utf-8")
 
     def one(copy: Path, plan: ModulePlan, mutant: Mutant) -> Result:
+        selected = plan.tests_for(mutant)
+        if selected == []:  # no test runs its lines: it survives without a run
+            return Result(mutant, "survived", 0.0, tests=0)
+        tests = plan.tests if selected is None else selected
         target = copy / mutant.path
         original = plan.source
         target.write_text(apply_mutant(original, mutant), encoding="utf-8")
         try:
-            outcome, secs, _ = run_tests(copy, plan.tests, plan.timeout_s)
+            outcome, secs, _ = run_tests(copy, tests, plan.timeout_s)
+            if outcome == "notfound" and selected is not None:  # a node id pytest cannot take back
+                tests, selected = plan.tests, None
+                outcome, secs, _ = run_tests(copy, tests, plan.timeout_s)
             if outcome == "timeout":  # once more with twice the time: the machine may just be busy
-                outcome, secs, _ = run_tests(copy, plan.tests, 2 * plan.timeout_s)
+                outcome, secs, _ = run_tests(copy, tests, 2 * plan.timeout_s)
         finally:
             target.write_text(original, encoding="utf-8")
-        verdict = {"passed": "survived", "failed": "killed"}.get(outcome, outcome)
-        return Result(mutant, verdict, secs)
+        verdict = {"passed": "survived", "failed": "killed", "notfound": "error"}.get(outcome, outcome)
+        return Result(mutant, verdict, secs, tests=-1 if selected is None else len(selected))
 
     pending: dict[Future[Result], Path] = {}
     with ThreadPoolExecutor(max_workers=len(copies)) as pool:
@@ -741,8 +798,9 @@ def main(argv: list[str] | None = None) -> int:
                     free.append(pending.pop(fut))
                     r = fut.result()
                     results.append(r)
-                    print(f"[{len(results)}/{len(work)}] {r.outcome:8} {r.seconds:5.1f}s {r.mutant.describe()}",
-                          flush=True)
+                    ran = "files" if r.tests < 0 else f"{r.tests} tests"
+                    print(f"[{len(results)}/{len(work)}] {r.outcome:8} {r.seconds:5.1f}s {ran:>9} "
+                          f"{r.mutant.describe()}", flush=True)
                 write()
         except KeyboardInterrupt:
             status = "interrupted"
