@@ -19,18 +19,23 @@ What it does:
    ``if TYPE_CHECKING:`` and ``if __name__ == "__main__":``.
 3. Samples ``--per-module`` sites per module with a random generator seeded by
    ``(seed, module path)``, so a run is repeatable.
-4. Picks the tests of each module (:func:`tests_for_module`): test files under ``tests/`` that
-   import the module (or, when none does, a module that imports it), leaving out
-   ``tests/ui``/``tests/render`` (Qt, GL) and files slower than ``--max-file-seconds`` in the
-   baseline; tests marked ``slow`` are deselected.
-5. Baseline: runs each module's tests unmutated once (they must pass) and sets the timeout to
-   ``--timeout`` (default: 3 x baseline + 5 s).
+4. Picks the tests of each module (:func:`tests_for_module`, :func:`rank_tests`): test files
+   under ``tests/`` that import the module (or a module that imports it), leaving out
+   ``tests/ui``/``tests/render`` (Qt, GL); its own ``test_<module>*`` files first, then the
+   files that mention more of its names; at most ``--max-test-files`` that pass alone, files
+   slower than ``--max-file-seconds`` left out (not the module's own); tests marked ``slow``
+   are deselected.
+5. Baseline: runs each module's tests unmutated once (they must pass), under the line tracer
+   of ``tools/mutation_trace.py`` (``--select lines``): which test ran which of the module's
+   lines. The timeout is ``--timeout`` (default: 3 x baseline + 5 s).
 6. For each mutant: writes the mutated module into the private copy, runs
-   ``pytest -x -q -p no:cacheprovider -m "not slow"`` on the module's tests under ``nice -n 19``
-   with ``QTANIMATOR_NO_NUMBA=1`` (the numpy kernels run, so mutating them means something),
-   ``CI`` unset, ``PYTHONDONTWRITEBYTECODE=1``, ``PYTHONPATH`` and cwd in the copy, then
-   restores the file. Outcome: ``killed`` (tests fail), ``survived`` (tests pass),
-   ``timeout`` and ``error`` (collection/import error) -- both of the last count as killed.
+   ``pytest -x -q -p no:cacheprovider -m "not slow"`` under ``nice -n 19`` on the tests that
+   ran the mutated lines (all the files when the line runs at import; none -- the mutant
+   survives unrun -- when no test runs it), with ``QTANIMATOR_NO_NUMBA=1`` (the numpy kernels
+   run, so mutating them means something), ``CI`` unset, ``PYTHONDONTWRITEBYTECODE=1``,
+   ``PYTHONPATH`` and cwd in the copy, then restores the file. Outcome: ``killed`` (tests
+   fail), ``survived`` (tests pass), ``timeout`` and ``error`` (collection/import error) --
+   both of the last count as killed.
 7. Writes the report after every mutant (so a run stopped by ``--budget-minutes`` or Ctrl-C
    still leaves one): killed/total per module, the pooled score with a 95 % Wilson interval,
    a site-weighted (stratified) estimate, and every survivor as ``file:line  mutation``.
