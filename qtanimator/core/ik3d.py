@@ -152,7 +152,7 @@ def solve_ik(skeleton: Skeleton, end: int, target: npt.ArrayLike, dofs: Sequence
     err = float(np.linalg.norm(goal - p))
     it = 0
     for it in range(1, iterations + 1):
-        if err < tolerance or not dof_list:
+        if err <= tolerance or not dof_list:  # reached at the tolerance, as every other solver
             it -= 1
             break
         e = goal - p

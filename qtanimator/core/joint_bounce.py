@@ -84,10 +84,6 @@ class BoundedUnit:
         angle, rate = self.outside(t)
         return float(angle[i]), float(rate[i])
 
-    def outside_of_limits(self, theta: FloatArray, t: float) -> npt.NDArray[np.bool_]:
-        loc = self.local(theta, t)
-        return np.asarray((loc > self.hi) | (loc < self.lo))
-
 
 def hermite(a0: FloatArray, r0: FloatArray, a1: FloatArray, r1: FloatArray,
             tau: float) -> Callable[[float], tuple[FloatArray, FloatArray]]:
