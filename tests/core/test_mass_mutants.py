@@ -11,7 +11,10 @@ import numpy as np
 import pytest
 
 from qtanimator.core.mass import (
+    MassProperties,
+    combine,
     polygon_properties,
+    polyline_properties,
     reference_shape_mass_properties,
     shape_mass_properties,
 )
@@ -64,3 +67,55 @@ def test_reference_line_moment_is_four_thirds_rho_l_d2() -> None:
     assert m.mass == pytest.approx(1e-4 * 10.0)
     np.testing.assert_allclose(m.centroid, (3.0, 4.0))
     assert m.inertia == pytest.approx(1e-4 * (4.0 / 3.0) * 10.0 * 13.0)
+
+
+def test_combine_sums_masses_and_moments_and_weighs_the_centroids() -> None:
+    """Masses 1 at (0, 0) and 3 at (4, 0): total 4, centroid (3, 0); moments add. With no mass
+    at all the centroid is the pivot and the mass 0."""
+    pivot = np.array([1.0, 1.0])
+    a = MassProperties(1.0, np.array([0.0, 0.0]), 2.0, pivot)
+    b = MassProperties(3.0, np.array([4.0, 0.0]), 5.0, pivot)
+    both = combine([a, b], pivot)
+    assert both.mass == 4.0 and both.inertia == 7.0
+    np.testing.assert_allclose(both.centroid, [3.0, 0.0])
+    np.testing.assert_array_equal(both.pivot, pivot)
+    empty = combine([MassProperties(0.0, np.array([5.0, 5.0]), 0.5, pivot)], pivot)
+    assert empty.mass == 0.0 and empty.inertia == 0.5
+    np.testing.assert_array_equal(empty.centroid, pivot)
+    assert combine([], pivot).mass == 0.0
+
+
+def test_length_offset_and_moment_about_the_centroid() -> None:
+    """Centroid (4, 5) from pivot (1, 1): offset (3, 4), length 5; a mass of 2 with I = 60
+    about the pivot has 60 − 2·25 = 10 about its centroid (parallel axes), clamped at 0."""
+    p = MassProperties(2.0, np.array([4.0, 5.0]), 60.0, np.array([1.0, 1.0]))
+    np.testing.assert_array_equal(p.offset, [3.0, 4.0])
+    assert p.length == 5.0
+    assert p.inertia_about_centroid == pytest.approx(10.0)
+    assert MassProperties(2.0, np.array([4.0, 5.0]), 40.0, np.array([1.0, 1.0])).inertia_about_centroid == 0.0
+
+
+def test_polyline_of_one_or_no_point_has_no_mass() -> None:
+    """A single point, or points all in one place: no length, so no mass or moment, the
+    centroid on the point; no points: the centroid at the pivot."""
+    one = polyline_properties([[2.0, 3.0]], 5.0, [0.0, 0.0])
+    assert one.mass == 0.0 and one.inertia == 0.0
+    np.testing.assert_array_equal(one.centroid, [2.0, 3.0])
+    same = polyline_properties([[2.0, 3.0], [2.0, 3.0], [2.0, 3.0]], 5.0, [0.0, 0.0])
+    assert same.mass == 0.0 and same.inertia == 0.0
+    np.testing.assert_array_equal(same.centroid, [2.0, 3.0])
+    none = polyline_properties(np.zeros((0, 2)), 5.0, [1.0, 1.0])
+    assert none.mass == 0.0
+    np.testing.assert_array_equal(none.centroid, [1.0, 1.0])
+    # a 3-4-5 segment of density 2 about its midpoint: m = 10, I = m·ℓ²/12 = 250/12
+    seg = polyline_properties([[0.0, 0.0], [3.0, 4.0]], 2.0, [1.5, 2.0])
+    assert seg.mass == pytest.approx(10.0) and seg.inertia == pytest.approx(250.0 / 12.0)
+
+
+def test_point_shape_is_a_point_mass_of_its_stroke_alpha() -> None:
+    """A "point" shape weighs its stroke alpha (2) at its point (3, 4): about the origin
+    I = m·d² = 2·25 = 50, in the exact and in the starter's reference table alike."""
+    pt = Shape(np.array([[3.0, 4.0]]), False, stroke=(0.0, 0.0, 0.0, 2.0), kind="point")
+    for props in (shape_mass_properties(pt, [0.0, 0.0]), reference_shape_mass_properties(pt, [0.0, 0.0])):
+        assert props.mass == 2.0 and props.inertia == pytest.approx(50.0)
+        np.testing.assert_array_equal(props.centroid, [3.0, 4.0])

@@ -28,3 +28,13 @@ def test_given_normals_in_any_layout_are_transformed():
         np.testing.assert_allclose(skin_normals(skin, world, normals=layout), expected, atol=1e-15)
     # without normals: the face's own, +z, unchanged by a turn about z
     np.testing.assert_allclose(skin_normals(skin, world), np.tile([0.0, 0.0, 1.0], (3, 1)), atol=1e-15)
+
+
+def test_from_padded_reads_rows_as_vertices_and_drops_zero_weights():
+    """Three vertices with two slots each (V != K): vertex i owns row i; zero weights go."""
+    b = SkinBinding.from_padded([[0, 1], [2, 0], [1, 1]], [[0.25, 0.75], [1.0, 0.0], [0.5, 0.5]], 3)
+    assert (b.num_vertices, b.num_joints, len(b)) == (3, 3, 5)
+    np.testing.assert_array_equal(b.counts(), [2, 1, 2])
+    dense = np.zeros((3, 3))
+    np.add.at(dense, (b.vertex, b.joint), b.weight)
+    np.testing.assert_allclose(dense, [[0.25, 0.75, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]])
