@@ -23,15 +23,17 @@ What it does:
    under ``tests/`` that import the module (or a module that imports it), leaving out
    ``tests/ui``/``tests/render`` (Qt, GL); its own ``test_<module>*`` files first, then the
    files that mention more of its names; at most ``--max-test-files`` that pass alone, files
-   slower than ``--max-file-seconds`` left out (not the module's own); tests marked ``slow``
+   slower than ``--max-file-seconds`` left out (not ``test_<module>.py`` or
+   ``test_<module>_mutants.py``); tests marked ``slow``
    are deselected.
-5. Baseline: runs each module's tests unmutated once (they must pass), under the line tracer
-   of ``tools/mutation_trace.py`` (``--select lines``): which test ran which of the module's
+5. Baseline: runs each module's tests unmutated once (they must pass); with ``--select lines``
+   under the line tracer of ``tools/mutation_trace.py``: which test ran which of the module's
    lines. The timeout is ``--timeout`` (default: 3 x baseline + 5 s).
 6. For each mutant: writes the mutated module into the private copy, runs
-   ``pytest -x -q -p no:cacheprovider -m "not slow"`` under ``nice -n 19`` on the tests that
-   ran the mutated lines (all the files when the line runs at import; none -- the mutant
-   survives unrun -- when no test runs it), with ``QTANIMATOR_NO_NUMBA=1`` (the numpy kernels
+   ``pytest -x -q -p no:cacheprovider -m "not slow"`` under ``nice -n 19`` on the module's
+   test files (``--select lines``: on the tests that ran the mutated lines, all the files when
+   the line runs at import, none -- the mutant survives unrun -- when no test runs it), with
+   ``QTANIMATOR_NO_NUMBA=1`` (the numpy kernels
    run, so mutating them means something), ``CI`` unset, ``PYTHONDONTWRITEBYTECODE=1``,
    ``PYTHONPATH`` and cwd in the copy, then restores the file. Outcome: ``killed`` (tests
    fail), ``survived`` (tests pass), ``timeout`` and ``error`` (collection/import error) --
@@ -436,6 +438,13 @@ def own_tier(path: str, test: str) -> int:
     return 0 if stem in name else 1 if stem.split("_")[0] in name else 2 if p.parent.name in name else 3
 
 
+def is_own(path: str, test: str) -> bool:
+    """``test`` is the module's own file: ``test_<module>.py`` or ``test_<module>_mutants.py``."""
+    p = Path(path)
+    stem = p.parent.name if p.name == "__init__.py" else p.stem.lstrip("_")
+    return Path(test).stem in (f"test_{stem}", f"test_{stem}_mutants")
+
+
 def rank_tests(path: str, tests: list[str]) -> list[str]:
     """``tests`` in the order to try them for ``path``: files named after the module (or its
     package, for ``pkg/__init__.py`` and the modules of a subpackage) first; then, within each
@@ -662,9 +671,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--numba", choices=["off", "python"], default="off",
                         help="off: QTANIMATOR_NO_NUMBA=1 (numpy); python: NUMBA_DISABLE_JIT=1 (kernels in Python)")
     parser.add_argument("--list", action="store_true", help="only list the sampled mutants")
-    parser.add_argument("--select", choices=["lines", "files"], default="lines",
-                        help="lines: run only the tests that ran the mutated lines in the (traced) baseline; "
-                             "files: the module's whole test files for every mutant")
+    parser.add_argument("--select", choices=["lines", "files"], default="files",
+                        help="files: the module's whole test files for every mutant; lines: only the tests "
+                             "that ran the mutated lines in a traced baseline (the trace makes the baseline "
+                             "of numpy-heavy tests, such as the cloth's, several times slower)")
     args = parser.parse_args(argv)
     args.argv = sys.argv[1:] if argv is None else argv
     global NUMBA_MODE
@@ -719,11 +729,11 @@ def main(argv: list[str] | None = None) -> int:
             if len(usable) >= args.max_test_files:
                 break
             if t not in file_times:
-                limit = 600 if own_tier(plan.path, t) == 0 else args.max_file_seconds + 10
+                limit = 600 if is_own(plan.path, t) else args.max_file_seconds + 10
                 outcome, secs, _ = run_tests(copies[0], [t], timeout=limit)
                 file_times[t] = (outcome, secs)
                 print(f"baseline {t}: {outcome} {secs:.1f}s", flush=True)
-            own = own_tier(plan.path, t) == 0  # named after the module: kept however slow
+            own = is_own(plan.path, t)  # test_<module>.py / test_<module>_mutants.py: kept however slow
             if file_times[t][0] == "passed" and (own or file_times[t][1] <= args.max_file_seconds):
                 usable.append(t)
         plan.tests = usable

@@ -283,3 +283,111 @@ def test_a_sphere_pushes_out_only_the_points_inside_its_radius() -> None:
     collide(p, x, v, [sphere], None, np.zeros(0, dtype=np.int64))
     assert x[0] == pytest.approx([0.3, 0.0, 0.0], abs=1e-9)
     assert x[1].tolist() == [0.0, 0.5, 0.0] and x[2].tolist() == [0.0, 0.0, -0.9]
+
+
+# ------------------------------------------------------------------ step details (seed 104)
+def test_warm_start_reuses_the_last_velocity_change() -> None:
+    """Free fall of an unstretched cloth: every step needs the same Δv = −g·h (springs see no
+    relative motion), so a solve warm-started from the last one has nothing left to do."""
+    p = ClothParams(rows=3, cols=3, pin_mode="none", ground_enabled=False, drag_coefficient=0.0, substeps=1)
+    cloth = Cloth(p, accelerate=False)
+    assert cloth.warm_start
+    cloth.step(1.0 / 60.0)
+    assert cloth.last_iterations > 0
+    cloth.step(1.0 / 60.0)
+    assert cloth.last_iterations == 0
+    np.testing.assert_allclose(cloth.velocities[:, 1], -9.8 * 2.0 / 60.0, rtol=1e-3)
+
+
+@pytest.mark.parametrize("accelerate", ACCELERATE)
+def test_the_solver_floor_is_a_rms_acceleration_of_1e_3(accelerate: bool) -> None:
+    """atol = 1e-3 m/s² × h × m × √N: with gravity 5e-4 m/s² on a free 4 × 4 cloth at rest the
+    right-hand side |h·m·g|·√N is below it (no iteration); with 2e-3 m/s² it is above (iterations)."""
+    for g, none in ((5e-4, True), (2e-3, False)):
+        p = ClothParams(rows=4, cols=4, gravity=g, pin_mode="none", ground_enabled=False, substeps=1)
+        cloth = Cloth(p, accelerate=accelerate)
+        cloth.step(1.0 / 60.0)
+        assert (cloth.last_iterations == 0) == none, g
+
+
+def test_stretch_picks_its_own_kind() -> None:
+    """A 3 × 4 cloth (dx = 0.3, dy = 0.4) stretched by 1.5 along x only: horizontal structural
+    and bend springs stretch by 0.5, vertical ones not at all, the diagonals by
+    √(0.45² + 0.4²)/0.5 − 1."""
+    p = ClothParams(rows=3, cols=4, width=0.9, height=0.8, ground_enabled=False)
+    cloth = Cloth(p, accelerate=False)
+    cloth.positions[:, 0] *= 1.5
+    structural = np.sort(cloth.stretch("structural"))
+    assert len(structural) == 3 * 3 + 2 * 4
+    np.testing.assert_allclose(structural, [0.0] * 8 + [0.5] * 9, atol=1e-12)
+    np.testing.assert_allclose(cloth.stretch("shear"), [math.hypot(0.45, 0.4) / 0.5 - 1.0] * 12, rtol=1e-12)
+    bend = np.sort(cloth.stretch("bend"))
+    np.testing.assert_allclose(bend, [0.0] * 4 + [0.5] * 6, atol=1e-12)
+
+
+def test_a_cloth_without_forces_that_limit_the_step_takes_one_substep() -> None:
+    p = ClothParams(rows=3, cols=3, integrator="symplectic", structural_stiffness=0.0, structural_damping=0.0,
+                    shear_stiffness=0.0, shear_damping=0.0, bend_stiffness=0.0, bend_damping=0.0,
+                    drag_coefficient=0.0)
+    cloth = Cloth(p, accelerate=False)
+    assert cloth._stable_dt() == math.inf
+    assert cloth.stable_substeps(1.0 / 24.0) == 1
+    assert cloth.substeps_for(1.0 / 24.0) == 1
+
+
+def test_reset_keeps_the_position_arrays() -> None:
+    """A viewer may hold ``positions`` / ``velocities``: reset and set_state refill them."""
+    cloth = Cloth(ClothParams(rows=3, cols=3), accelerate=False)
+    pos, vel = cloth.positions, cloth.velocities
+    state = cloth.state()
+    cloth.step(1.0 / 60.0)
+    cloth.reset()
+    assert cloth.positions is pos and cloth.velocities is vel
+    cloth.set_state(state)
+    assert cloth.positions is pos and cloth.velocities is vel
+
+
+def test_weak_gusts_blow_on_the_cloth() -> None:
+    """Turbulence 0.5 m/s (below 1): one symplectic step of a spring-free cloth in still air
+    moves as the drag of the gust field sampled at the start of the frame says."""
+    p = ClothParams(rows=3, cols=3, width=0.6, height=0.6, total_mass=0.09, gravity=0.0, ground_enabled=False,
+                    pin_mode="none", turbulence=0.5, turbulence_seed=5, integrator="symplectic", substeps=1,
+                    structural_stiffness=0.0, structural_damping=0.0, shear_stiffness=0.0, shear_damping=0.0,
+                    bend_stiffness=0.0, bend_damping=0.0, orientation=(0.4, 0.0, 0.0))
+    cloth = Cloth(p, accelerate=False)
+    x = cloth.positions.copy()
+    air = wind_at(p, turbulence_modes(5), 0.0, x)
+    coef = 0.5 * p.air_density * p.drag_coefficient
+    f = np.zeros_like(x)
+    for tri in cloth.triangles:
+        cross = np.cross(x[tri[1]] - x[tri[0]], x[tri[2]] - x[tri[0]])
+        area, n_hat = 0.5 * np.linalg.norm(cross), cross / np.linalg.norm(cross)
+        w = (0.0 - air[tri]).mean(axis=0)
+        f[tri] += -coef * np.dot(w, w) * area * np.dot(w / np.linalg.norm(w), n_hat) * n_hat / 3.0
+    dt = 1.0 / 120.0
+    cloth.step(dt)
+    assert np.abs(f).max() > 1e-4
+    np.testing.assert_allclose(cloth.velocities, f * dt / cloth.particle_mass, rtol=1e-9, atol=1e-15)
+
+
+@pytest.mark.parametrize("accelerate", ACCELERATE)
+def test_pins_move_linearly_over_the_substeps(accelerate: bool) -> None:
+    """Two symplectic substeps while the pins move: after the first the pins are half way
+    (start + Δ/2, velocity Δ/dt), after the second at their targets; the free particles follow
+    the reference forces."""
+    cloth = Cloth(ClothParams(**TILTED, integrator="symplectic", substeps=2), accelerate=accelerate)  # type: ignore[arg-type]
+    _perturbed(cloth, seed=3)
+    pins = cloth.pinned_indices
+    cloth.move_pins((0.03, -0.02, 0.05))
+    start, end = cloth.positions[pins].copy(), cloth.pin_targets.copy()
+    dt = 1.0 / 300.0
+    h = dt / 2
+    x, v = cloth.positions.copy(), cloth.velocities.copy()
+    for s in (1, 2):
+        v = v + _reference_force(cloth, x, v) * (h / cloth.particle_mass)
+        v[pins] = (end - start) / dt
+        x = x + v * h
+        x[pins] = end if s == 2 else start + (end - start) * 0.5
+    cloth.step(dt)
+    np.testing.assert_allclose(cloth.positions, x, rtol=1e-9, atol=1e-10)
+    np.testing.assert_allclose(cloth.velocities, v, rtol=1e-6, atol=1e-7)
