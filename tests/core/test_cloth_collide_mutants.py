@@ -184,3 +184,17 @@ def test_a_particle_exactly_on_a_capsule_surface_is_not_inside() -> None:
     collide(ClothParams(ground_enabled=False, collision_margin=0.0), x, v, [], (a, b, r), NONE)
     np.testing.assert_array_equal(x, [[0.5, 0.5, 0.0]])
     np.testing.assert_array_equal(v, [[0.0, -1.0, 0.0]])
+
+
+@pytest.mark.parametrize("speed", [0.5, 3.0])
+def test_a_particle_inside_a_capsule_moving_out_keeps_its_velocity(speed: float) -> None:
+    """Only inward velocity is dropped: a point 0.1 inside the capsule (1, 1, 1) → (3, 1, 1),
+    radius 0.2 (margin 0), moving straight out along +y at 0.5 or 3 m/s (below and above
+    1 m/s), is pushed to the surface (2, 1.2, 1) and keeps (0, speed, 0.25)."""
+    p = ClothParams(ground_enabled=False, collision_margin=0.0)
+    a, b, r = np.array([[1.0, 1.0, 1.0]]), np.array([[3.0, 1.0, 1.0]]), np.array([0.2])
+    x = np.array([[2.0, 1.1, 1.0]])
+    v = np.array([[0.0, speed, 0.25]])
+    collide(p, x, v, [], (a, b, r), NONE)
+    np.testing.assert_allclose(x[0], [2.0, 1.2, 1.0], rtol=1e-11)
+    np.testing.assert_array_equal(v[0], [0.0, speed, 0.25])

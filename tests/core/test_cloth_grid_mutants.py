@@ -138,3 +138,23 @@ def test_nearest_particle_ignores_particles_behind_and_far() -> None:
     assert nearest_particle(pts, (0.0, 0.0, 0.0), (0.0, 0.0, -1.0)) == 0
     assert nearest_particle(pts, (0.0, 0.0, 0.0), (0.0, 0.0, 0.0)) is None
     assert nearest_particle(pts[:1], (0.0, 0.0, 0.0), (0.0, 0.0, 1.0)) is None
+
+
+def test_the_ray_direction_length_does_not_matter() -> None:
+    """The distance to a ray is |w|² − (w·d̂)² with d̂ the unit direction: (0.1, 0, 1) is 0.1
+    from the z axis and (0.5, 0, 10) 0.5, whatever the length of the direction given (a
+    direction left unnormalised would weigh the far particle's (w·d)² more and pick it)."""
+    pts = np.array([[0.5, 0.0, 10.0], [0.1, 0.0, 1.0]])
+    for length in (0.25, 1.0, 2.0, 40.0):
+        assert nearest_particle(pts, (0.0, 0.0, 0.0), (0.0, 0.0, length)) == 1
+        assert nearest_particle(pts, (0.0, 0.0, 0.0), (0.0, 0.0, length), max_distance=0.11) == 1
+        assert nearest_particle(pts, (0.0, 0.0, 0.0), (0.0, 0.0, length), max_distance=0.09) is None
+
+
+def test_a_particle_exactly_max_distance_from_the_ray_counts() -> None:
+    """"Only particles that close to the ray count": (0.5, 0, 1) is |w|² − (w·d̂)² =
+    1.25 − 1 = 0.25 = 0.5² (every number exact in binary) from the z axis, so with
+    max_distance 0.5 it is picked; with 0.4999 it is not."""
+    pts = np.array([[0.5, 0.0, 1.0]])
+    assert nearest_particle(pts, (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), max_distance=0.5) == 0
+    assert nearest_particle(pts, (0.0, 0.0, 0.0), (0.0, 0.0, 1.0), max_distance=0.4999) is None

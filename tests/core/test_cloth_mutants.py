@@ -13,7 +13,7 @@ import math
 import numpy as np
 import pytest
 
-from qtanimator.core.cloth import IMPLICIT_MAX_STEP, Cloth, ClothParams
+from qtanimator.core.cloth import IMPLICIT_MAX_STEP, MAX_AUTO_SUBSTEPS, Cloth, ClothBlowUp, ClothParams
 from qtanimator.core.cloth_collide import _respond, capsules, collide
 from qtanimator.core.cloth_forces import drag_rate, stable_dt, turbulence_modes, wind_at
 from qtanimator.core.cloth_grid import vertex_normals
@@ -391,3 +391,19 @@ def test_pins_move_linearly_over_the_substeps(accelerate: bool) -> None:
     cloth.step(dt)
     np.testing.assert_allclose(cloth.positions, x, rtol=1e-9, atol=1e-10)
     np.testing.assert_allclose(cloth.velocities, v, rtol=1e-6, atol=1e-7)
+
+
+def test_auto_substeps_are_refused_past_5000_not_at_5000() -> None:
+    """docs/user-guide.md: on auto the symplectic integrator "refuses settings that would need
+    more than 5000 a frame". A frame of 5000.5 stable substeps needs 5001 (refused before
+    stepping, naming the implicit integrator); one of 4999.5 needs 5000 (allowed)."""
+    assert MAX_AUTO_SUBSTEPS == 5000
+    cloth = Cloth(ClothParams(rows=2, cols=2, integrator="symplectic", ground_enabled=False))
+    limit = cloth._stable_dt()
+    assert cloth.substeps_for(4999.5 * limit) == 5000
+    assert cloth.substeps_for(5000.5 * limit) == 5001
+    before = cloth.positions.copy()
+    with pytest.raises(ClothBlowUp) as info:
+        cloth.step(5000.5 * limit)
+    assert info.value.parameter == "integrator"
+    np.testing.assert_array_equal(cloth.positions, before)

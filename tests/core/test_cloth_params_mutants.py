@@ -129,3 +129,19 @@ def test_particle_mass_and_per_kind_settings() -> None:
     assert p.particle_mass == pytest.approx(0.1, rel=1e-15)
     assert p.stiffness("shear") == 77.0
     assert p.damping("bend") == 0.125
+
+
+def test_the_defaults_are_the_user_guides() -> None:
+    """docs/user-guide.md, "Defaults": a new cloth is 20 × 20 particles, 1 m × 1 m and 1 kg;
+    springs 200 / 100 / 20 N/m with damping 0.4 / 0.2 / 0.05 N·s/m; drag coefficient 1, air
+    density 1.225 kg/m³, no wind, gravity 9.8 m/s², ground at height 0, top corners pinned,
+    integrator implicit, substeps auto (0)."""
+    p = ClothParams()
+    assert (p.rows, p.cols) == (20, 20)
+    assert (p.width, p.height, p.total_mass) == (1.0, 1.0, 1.0)
+    assert (p.structural_stiffness, p.shear_stiffness, p.bend_stiffness) == (200.0, 100.0, 20.0)
+    assert (p.structural_damping, p.shear_damping, p.bend_damping) == (0.4, 0.2, 0.05)
+    assert (p.drag_coefficient, p.air_density, p.wind) == (1.0, 1.225, (0.0, 0.0, 0.0))
+    assert (p.gravity, p.ground_enabled, p.ground_height) == (9.8, True, 0.0)
+    assert (p.pin_mode, p.integrator, p.substeps) == ("top_corners", "implicit", AUTO_SUBSTEPS)
+    assert AUTO_SUBSTEPS == 0

@@ -205,3 +205,42 @@ def test_a_straight_chain_bends_towards_the_pole():
             v[j, ax] = x
         knee = sk.world_matrices(v)[2, :3, 3]
         np.testing.assert_allclose(knee, a + [0.6, 0.0, 0.0] + 0.8 * side, atol=1e-9)
+
+
+def _oblique_knee(scale: float) -> Skeleton:
+    """a (3 free DOFs) -> b at (s, 0, 0), a hinge about z only -> c at b + (s, 0, s): the
+    lower bone leans out of the hinge's plane (half of it along the hinge axis)."""
+    return Skeleton([Joint("a", None, (0, 0, 0), free()),
+                     Joint("b", 0, (scale, 0, 0), (Dof(0, 0, 0), Dof(0, 0, 0), Dof())),
+                     Joint("c", 1, (scale, 0, scale), (Dof(0, 0, 0), Dof(0, 0, 0), Dof(0, 0, 0)))],
+                    rotation_order="xyz")
+
+
+OBLIQUE_DOFS = [(0, 0), (0, 1), (0, 2), (1, 2)]
+
+
+def test_two_bone_hinge_oblique_to_the_lower_bone_is_solved_analytically():
+    """Turning the hinge by theta about z moves c - b = (1, 0, 1) to (cos, sin, 1), so
+    |c - a|^2 = (1 + cos)^2 + sin^2 + 1 = 3 + 2 cos(theta). A target 2 from a needs
+    cos(theta) = 1/2: |theta| = pi/3, whatever the method. With no CCD sweep allowed
+    (iterations=0) only the analytic step, which must split the lower bone into its part
+    along the hinge and the part across it, can get there."""
+    target = np.array([1.2, 1.6, 0.0])   # |target| = 2
+    res = solve_two_bone(_oblique_knee(1.0), 2, target, dofs=OBLIQUE_DOFS, iterations=0)
+    assert res.error < 1e-9
+    np.testing.assert_allclose(res.position, target, atol=1e-9)
+    assert abs(res.values[(1, 2)]) == pytest.approx(math.pi / 3, abs=1e-9)
+
+
+def test_two_bone_is_scale_invariant_for_a_tiny_skeleton():
+    """The same skeleton and target scaled by 1e-13 (tolerance too) is the same problem:
+    the same joint angles, in one analytic step. Bones of 1e-13 are short in absolute
+    terms but not relative to the chain, so they are not the "zero-length bone" case."""
+    s = 1e-13
+    target = np.array([1.2, 1.6, 0.0])
+    big = solve_two_bone(_oblique_knee(1.0), 2, target, dofs=OBLIQUE_DOFS, iterations=0)
+    tiny = solve_two_bone(_oblique_knee(s), 2, target * s, dofs=OBLIQUE_DOFS, iterations=0, tolerance=1e-5 * s)
+    assert tiny.error <= 1e-9 * s
+    assert tiny.iterations == big.iterations
+    for key, value in big.values.items():
+        assert tiny.values[key] == pytest.approx(value, abs=1e-9)

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from qtanimator.core.ik import IKStats, planar_chain
-from qtanimator.core.ik_methods import _extrapolate, solve_ccd, solve_fabrik, solve_two_bone
+from qtanimator.core.ik_methods import _extrapolate, solve_ccd, solve_fabrik, solve_two_bone, two_bone_closed_form
 
 
 class _LineChain:
@@ -187,3 +187,34 @@ def test_plain_fabrik_converges_on_a_reachable_target(target):
                        accelerate=False, tolerance=1e-9, stats=stats)
     assert stats.error < 1e-9
     np.testing.assert_allclose(ch.pose(out, (0.0, 0.0)).to_world(3, [200.0, 0.0]), target, atol=1e-8)
+
+
+def test_ccd_with_the_target_on_an_off_axis_tip_runs_no_sweep():
+    """The chain translated by (0, 30): the tip (150, 0) of the straight chain is at
+    (150, 30), and so is the target. The error is 0 from the start (both coordinates
+    count), so no sweep runs and nothing moves."""
+    ch = planar_chain(3, 50.0)
+    stats = IKStats()
+    out = solve_ccd(ch, np.zeros(3), (0.0, 30.0), 2, [150.0, 0.0], [150.0, 30.0], tolerance=1e-4, stats=stats)
+    assert stats.iterations == 0
+    assert stats.error <= 1e-12
+    np.testing.assert_array_equal(out, np.zeros(3))
+
+
+@pytest.mark.parametrize("upper, lower", [(0.1, 0.3), (0.1, 1.1), (0.1, 2.9)])
+def test_two_bone_closed_form_fully_folded(upper, lower):
+    """A target on the first pivot with a longer lower bone: the reach is clamped to
+    lower - upper and the chain folds flat. The inner angle is 0, so the lower bone turns
+    by pi; the upper bone points away from the target (its angle from the line to the
+    target is pi). (For these lengths the law of cosines rounds to just above 1.)"""
+    first, turn = two_bone_closed_form(upper, lower, 0.0)
+    assert abs(first) == pytest.approx(math.pi, abs=1e-7)
+    assert turn == pytest.approx(math.pi, abs=1e-7)
+
+
+@pytest.mark.parametrize("upper, lower", [(0.0, 1.0), (1.0, 0.0), (0.0, 0.0)])
+def test_two_bone_closed_form_with_a_zero_length_bone_returns_two_finite_angles(upper, lower):
+    """A bone of no length determines no angle; the function must still return its
+    documented pair of angles (no division by zero, no NaN)."""
+    first, turn = two_bone_closed_form(upper, lower, 0.5)
+    assert math.isfinite(first) and math.isfinite(turn)

@@ -192,3 +192,72 @@ def test_a_coupled_bounce_acts_through_the_mass_matrix() -> None:
     assert float(impulse[0]) == pytest.approx(-float(impulse[1]), rel=1e-12)
     assert abs(float(om[0])) > 0.1  # the parent member recoils
     np.testing.assert_allclose(th, [0.1 * om[0], 0.3 + 0.1 * om[1]], atol=1e-13)
+
+
+def test_a_crossing_on_a_sample_point_is_found_exactly() -> None:
+    """θ = t (no acceleration) and hi = 0.25 over a step of 1: the crossing sits exactly on
+    the second of the eight samples (g(0.25) = 0, every number exact in binary), so the root
+    finder starts from a bracket whose left end is the root itself. The bounce is at 0.25,
+    rate 1 → −e = −0.5, then θ = 0.25 − 0.5 · 0.75 = −0.125."""
+    unit = BoundedUnit(np.array([0]), np.array([-1.0]), np.array([0.25]), np.array([-1]), still_parent)
+    bounces: list[Bounce] = []
+    th, om = bounded_step(unit, free_step(), np.array([0.0]), np.array([1.0]), 1.0, 0.5, bounces)
+    [b] = bounces
+    assert b.time == pytest.approx(0.25, abs=1e-15) and b.limit == 0.25
+    assert b.rate_before == 1.0 and b.rate_after == -0.5
+    assert float(om[0]) == -0.5
+    assert float(th[0]) == pytest.approx(-0.125, abs=1e-15)
+
+
+def test_a_step_ending_exactly_on_the_limit_has_not_left_it() -> None:
+    """The local angle must stay in the closed interval [lo, hi]: θ = t over a step of 0.25
+    ends exactly on hi = 0.25 (exact in binary), inside, so the step is not cut and keeps
+    rate 1. The next step starts on the limit moving out: it bounces at once (time 0),
+    rate 1 → −0.5, and ends at 0.25 − 0.5 · 0.25 = 0.125."""
+    unit = BoundedUnit(np.array([0]), np.array([-1.0]), np.array([0.25]), np.array([-1]), still_parent)
+    bounces: list[Bounce] = []
+    th, om = bounded_step(unit, free_step(), np.array([0.0]), np.array([1.0]), 0.25, 0.5, bounces)
+    assert not bounces
+    assert float(th[0]) == 0.25 and float(om[0]) == 1.0
+    th, om = bounded_step(unit, free_step(), th, om, 0.25, 0.5, bounces)
+    [b] = bounces
+    assert b.time == 0.0 and b.rate_before == 1.0 and b.rate_after == -0.5
+    assert float(om[0]) == -0.5
+    assert float(th[0]) == pytest.approx(0.125, abs=1e-15)
+
+
+def test_a_concave_crossing_is_found_in_few_evaluations() -> None:
+    """The Illinois rule for the other side: a decelerating joint (g concave, the bracket's
+    right end moves every time) also converges superlinearly, far below bisection's ~50."""
+    calls = [0]
+    base = free_step(-3.0)
+
+    def counted(th: np.ndarray, om: np.ndarray, t: float, h: float) -> tuple[np.ndarray, np.ndarray]:
+        calls[0] += 1
+        return base(th, om, t, h)
+
+    unit = BoundedUnit(np.array([0]), np.array([-1.0]), np.array([0.1]), np.array([-1]), still_parent)
+    bounces: list[Bounce] = []
+    bounded_step(unit, counted, np.array([0.0]), np.array([1.0]), 0.3, 0.5, bounces)
+    h_star = 0.2 / (1.0 + np.sqrt(1.0 - 2.0 * 3.0 * 0.1))  # v h − α h²/2 = 0.1
+    assert bounces[0].time == pytest.approx(h_star, abs=1e-15)
+    assert calls[0] < 35
+
+
+def test_a_joint_on_its_limit_moving_in_and_pushed_back_out() -> None:
+    """On hi = 0 at the start moving in at −1, pushed out by α = 4: θ = −h + 2h² is back on the
+    limit at h = 1/2 (a sample point, every number exact in binary; not at h = 0) with rate
+    −1 + 4·½ = 1 → −e = −0.5; then θ = −0.5 s + 2 s² is on it again at s = 1/4 (t = 3/4) with
+    rate 0.5 → −0.25 (each crossing to ~1e-15 of what is left of the step). No bounce is
+    before its predecessor or outside the step."""
+    unit = BoundedUnit(np.array([0]), np.array([-1.0]), np.array([0.0]), np.array([-1]), still_parent)
+    bounces: list[Bounce] = []
+    bounded_step(unit, free_step(4.0), np.array([0.0]), np.array([-1.0]), 1.0, 0.5, bounces)
+    assert len(bounces) >= 2
+    assert bounces[0].time == pytest.approx(0.5, abs=1e-14)
+    assert bounces[0].rate_before == pytest.approx(1.0, rel=1e-13)
+    assert bounces[0].rate_after == pytest.approx(-0.5, rel=1e-13)
+    assert bounces[1].time == pytest.approx(0.75, abs=1e-14)
+    assert bounces[1].rate_before == pytest.approx(0.5, rel=1e-13)
+    times = [b.time for b in bounces]
+    assert times == sorted(times) and 0.0 < times[0] and times[-1] <= 1.0

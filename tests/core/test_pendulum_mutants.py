@@ -364,3 +364,39 @@ def test_a_dynamic_child_bounces_off_its_dynamic_parent() -> None:
     assert b.rate_before == pytest.approx(-5.0) and b.rate_after == pytest.approx(2.5)
     np.testing.assert_allclose(omega, [5.0, 7.5], rtol=1e-12)
     np.testing.assert_allclose(theta, [5.0 / 300.0, 0.01], atol=1e-14)
+
+
+def test_a_pendulum_starting_outside_its_limit_is_put_back_on_it() -> None:
+    """A joint whose local angle starts outside its limits (0.8 > hi = 0.5) is put on the
+    limit at the step's start (joint_bounce: the event at h = 0), even when the free step
+    would end inside: no gravity, moving in at ω = −40 over 0.01 s, it ends at
+    0.5 − 0.4 = 0.1 (not the free 0.8 − 0.4 = 0.4), its rate unchanged and no bounce (it
+    moves inward)."""
+    system = PendulumSystem(base_and_bob(), PendulumParams(g=0.0, damping=0.0, restitution=0.5), [None, (-1.0, 0.5)])
+    theta, omega = np.array([0.0, 0.8]), np.array([0.0, -40.0])
+    system.step(theta, omega, np.zeros((2, 2)), 0.01)
+    assert not system.bounces
+    assert float(theta[1]) == pytest.approx(0.1, abs=1e-14)
+    assert float(omega[1]) == -40.0
+
+
+@pytest.mark.parametrize("point_mass", [False, True])
+def test_a_joint_without_inertia_or_lever_does_not_swing(point_mass: bool) -> None:
+    """single_acceleration: "A joint without inertia does not swing and one without a lever
+    gets no point-mass forcing". A bob of mass 2 with its centre of mass on the pivot
+    (y0 = 0: no lever) and moment 0, under gravity and a pivot acceleration, keeps its angle
+    and rate (θ'' = 0) — beside an ordinary bob that does swing."""
+    pivot = np.array([0.0, 10.0])
+    dead = MassProperties(MASS, pivot.copy(), 0.0, pivot.copy())
+    live = MassProperties(MASS, pivot + Y0, INERTIA, pivot.copy())
+    ch = Character("z", [Joint("base", None, np.zeros(2)),
+                         Joint("dead", 0, pivot, is_dynamic=True, mass_properties=dead),
+                         Joint("live", 0, pivot, is_dynamic=True, mass_properties=live)])
+    params = PendulumParams(g=1000.0, damping=0.0, point_mass_forcing=point_mass, integrator="symplectic_euler")
+    system = PendulumSystem(ch, params)
+    theta, omega = np.array([0.0, 0.3, 0.3]), np.array([0.0, 0.7, 0.7])
+    acc = np.array([[0.0, 0.0], [40.0, -25.0], [40.0, -25.0]])
+    system.step(theta, omega, acc, 0.01)
+    assert float(theta[1]) == pytest.approx(0.3 + 0.01 * 0.7, abs=1e-15) and float(omega[1]) == 0.7
+    assert np.isfinite(theta).all() and np.isfinite(omega).all()
+    assert float(omega[2]) != 0.7

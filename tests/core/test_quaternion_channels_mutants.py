@@ -11,6 +11,7 @@ import pytest
 
 from qtanimator.core.channel import Channel, Interpolation, Key
 from qtanimator.core.quaternion_channels import euler_channels, quaternion_at, quaternion_channels, quaternions_at
+from qtanimator.core.rotation import normalize
 
 LIN = Interpolation.LINEAR
 
@@ -173,3 +174,16 @@ def test_repeated_calls_give_the_same_bits():
     again = np.array([quaternion_at(chans, [0, 0, 0, 1], t) for t in ts])
     np.testing.assert_array_equal(again, first)
     np.testing.assert_allclose(first, quaternions_at(chans, [0, 0, 0, 1], ts), atol=1e-15)
+
+
+def test_at_the_first_key_both_paths_give_the_normalised_key_exactly():
+    """At the first key's time the value is that key's components normalised once (what
+    evaluating each component there and normalising gives, quaternion_at's docstring),
+    bit for bit on both paths, not a slerp at u = 0 of the pre-normalised keys, which
+    normalises twice. Key (x, y, z, w) = (1, 2, 3, 4) is not unit: normalising it again
+    moves the last bit, so only the single normalisation matches exactly."""
+    raw = np.array([1.0, 2.0, 3.0, 4.0])
+    chans = _channels([0.5, 2.0], [raw, _about_z(1.0)])
+    expected = normalize(raw[None, :])[0]
+    np.testing.assert_array_equal(quaternions_at(chans, [0, 0, 0, 1], [0.5])[0], expected)
+    np.testing.assert_array_equal(quaternion_at(chans, [0, 0, 0, 1], 0.5), expected)

@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 
 from qtanimator.core.rotation import (
+    IDENTITY,
     axis_quaternions,
     euler_filter,
     euler_quaternions_with_rates,
@@ -198,3 +199,12 @@ def test_trs_and_polar():
 
 def test_euler_filter_of_one_sample_is_that_sample():
     np.testing.assert_array_equal(euler_filter([[0.1, 4.0, -5.0]], "xyz"), [[0.1, 4.0, -5.0]])
+
+
+def test_identity_is_the_unit_quaternion_of_no_rotation():
+    """(x, y, z, w) = (0, 0, 0, 1) (the module's convention, glTF's order): no rotation,
+    and the neutral element of the Hamilton product."""
+    np.testing.assert_array_equal(IDENTITY, [0.0, 0.0, 0.0, 1.0])
+    np.testing.assert_allclose(quaternion_to_matrix(IDENTITY), np.eye(3), atol=0.0)
+    q = axis_quaternions(np.array([0.7]), 1)[0]
+    np.testing.assert_allclose(quaternion_multiply(IDENTITY, q), q, atol=1e-15)
