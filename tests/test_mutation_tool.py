@@ -188,3 +188,21 @@ def test_a_mutant_runs_only_the_tests_that_ran_its_lines(mutation) -> None:  # t
     assert plan.tests_for(number) is None  # LIMIT = 3 runs at import: the whole files
     plan.lines = {"t.py::a": frozenset({3, 4, 7}), "t.py::b": frozenset({3, 4, 7})}
     assert plan.tests_for(mult) == []  # nobody runs it: it survives unrun
+
+
+def test_rerun_lists_only_the_survivors_of_a_report(mutation, tmp_path: Path, monkeypatch, capsys) -> None:  # type: ignore[no-untyped-def]
+    import json
+
+    monkeypatch.setattr(mutation, "REPO", tmp_path)
+    (tmp_path / "pkg").mkdir()
+    (tmp_path / "tests").mkdir()
+    (tmp_path / "qtanimator").mkdir()
+    source = "def f(a, b):\n    return a + b * 2\n"
+    (tmp_path / "pkg" / "m.py").write_text(source, encoding="utf-8")
+    sites = mutation.mutation_sites(source, "pkg/m.py")
+    plus, times = [m for m in sites if m.before == "a + b * 2"][0], [m for m in sites if m.before == "b * 2"][0]
+    report = [dict(vars(plus), outcome="survived", seconds=1.0), dict(vars(times), outcome="killed", seconds=1.0)]
+    (tmp_path / "r.json").write_text(json.dumps(report), encoding="utf-8")
+    mutation.main(["--modules", "pkg/m.py", "--rerun", str(tmp_path / "r.json"), "--list"])
+    listed = [line.strip() for line in capsys.readouterr().out.splitlines() if line.startswith("  ")]
+    assert listed == [plus.describe()]

@@ -588,8 +588,10 @@ def report(plans: list[ModulePlan], results: list[Result], args: argparse.Namesp
         f"date: {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}   status: {status}   "
         f"wall: {(time.monotonic() - started) / 60:.1f} min",
         f"command: python tools/mutation.py {' '.join(args.argv)}",
-        f"modules: {', '.join(args.modules)}   per-module: {args.per_module}   seed: {args.seed}   "
-        f"jobs: {args.jobs}   numba: {args.numba}   select: {args.select}   tree: {args.tree}",
+        f"modules: {', '.join(args.modules)}   "
+        + (f"rerun of the survivors of {args.rerun}   " if args.rerun else
+           f"per-module: {args.per_module}   seed: {args.seed}   ")
+        + f"jobs: {args.jobs}   numba: {args.numba}   select: {args.select}   tree: {args.tree}",
         "killed = the module's tests fail; timeout and import/collection error also count as killed.",
         "",
         f"{'module':44} {'sites':>5} {'run':>4} {'killed':>6} {'surv':>4} {'tmo':>3} {'err':>3} {'score':>6}"
@@ -671,6 +673,9 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--numba", choices=["off", "python"], default="off",
                         help="off: QTANIMATOR_NO_NUMBA=1 (numpy); python: NUMBA_DISABLE_JIT=1 (kernels in Python)")
     parser.add_argument("--list", action="store_true", help="only list the sampled mutants")
+    parser.add_argument("--rerun", default=None, metavar="REPORT.json",
+                        help="instead of sampling, run again the survivors of an earlier run's JSON report "
+                             "(same modules, sources unchanged since; e.g. after writing tests for them)")
     parser.add_argument("--select", choices=["lines", "files"], default="files",
                         help="files: the module's whole test files for every mutant; lines: only the tests "
                              "that ran the mutated lines in a traced baseline (the trace makes the baseline "
@@ -686,6 +691,12 @@ def main(argv: list[str] | None = None) -> int:
     args.tree = f"HEAD {head.stdout.strip() or '?'}" + (" + uncommitted changes" if dirty.stdout.strip() else "")
 
     files = module_files(args.modules)
+    rerun: dict[str, set[tuple[int, int, str]]] = {}
+    if args.rerun:
+        for entry in json.loads(Path(args.rerun).read_text(encoding="utf-8")):
+            if entry["outcome"] == "survived":
+                rerun.setdefault(entry["path"], set()).add((entry["start"], entry["end"], entry["replacement"]))
+        files = [f for f in files if f in rerun]
     test_files = [t for t in sorted((REPO / "tests").rglob("test_*.py"))
                   if not str(t.relative_to(REPO)).startswith(SLOW_TEST_DIRS)]
     package_files = sorted(p for p in (REPO / "qtanimator").rglob("*.py") if "__pycache__" not in p.parts)
@@ -693,8 +704,15 @@ def main(argv: list[str] | None = None) -> int:
     for path in files:
         source = (REPO / path).read_text(encoding="utf-8")
         sites = mutation_sites(source, path)
-        plans.append(ModulePlan(path=path, sites=len(sites), source=source,
-                                mutants=sample_sites(sites, args.per_module, args.seed, path, source),
+        if args.rerun:
+            chosen = [m for m in sites if (m.start, m.end, m.replacement) in rerun.get(path, set())]
+            missing = len(rerun.get(path, set())) - len(chosen)
+            if missing:
+                raise SystemExit(f"{path}: {missing} survivor(s) of {args.rerun} are not sites of the "
+                                 "current source (it changed since that run)")
+        else:
+            chosen = sample_sites(sites, args.per_module, args.seed, path, source)
+        plans.append(ModulePlan(path=path, sites=len(sites), source=source, mutants=chosen,
                                 tests=tests_for_module(path, test_files, package_files)))
     if args.list:
         for plan in plans:
