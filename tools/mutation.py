@@ -48,6 +48,7 @@ from __future__ import annotations
 import argparse
 import ast
 import dataclasses
+import difflib
 import functools
 import json
 import math
@@ -639,11 +640,29 @@ def report(plans: list[ModulePlan], results: list[Result], args: argparse.Namesp
     for r in sorted(results, key=lambda r: (r.mutant.path, r.mutant.start)):
         if r.outcome == "survived":
             lines.append("  " + r.mutant.describe() + ("   (no test runs this line)" if r.tests == 0 else ""))
+    if getattr(args, "gone", None):
+        lines += ["", "Survivors of the earlier run whose code is gone (not run, not counted):"]
+        lines += [f"  {g}" for g in args.gone]
     lines += ["", "Timeouts and import errors (counted as killed):"]
     for r in sorted(results, key=lambda r: (r.mutant.path, r.mutant.start)):
         if r.outcome in ("timeout", "error"):
             lines.append(f"  {r.outcome:7} " + r.mutant.describe())
     return "\n".join(lines) + "\n"
+
+
+def line_map(commit: str, path: str, source: str) -> dict[int, int]:
+    """Old line number -> line number in ``source`` for the lines of ``path`` at ``commit``
+    that are unchanged (git's copy of the file; every line maps to itself without one)."""
+    old = subprocess.run(["git", "-C", str(REPO), "show", f"{commit}:{path}"], capture_output=True, text=True)
+    new_lines = source.splitlines()
+    if not commit or old.returncode != 0:
+        return {i: i for i in range(1, len(new_lines) + 1)}
+    matcher = difflib.SequenceMatcher(None, old.stdout.splitlines(), new_lines, autojunk=False)
+    mapping: dict[int, int] = {}
+    for a, b, size in matcher.get_matching_blocks():
+        for k in range(size):
+            mapping[a + k + 1] = b + k + 1
+    return mapping
 
 
 def module_files(roots: list[str]) -> list[str]:
@@ -691,12 +710,18 @@ def main(argv: list[str] | None = None) -> int:
     args.tree = f"HEAD {head.stdout.strip() or '?'}" + (" + uncommitted changes" if dirty.stdout.strip() else "")
 
     files = module_files(args.modules)
-    rerun: dict[str, set[tuple[int, int, str]]] = {}
+    rerun: dict[str, list[dict[str, object]]] = {}
+    rerun_tree = ""
+    args.gone = []
     if args.rerun:
         for entry in json.loads(Path(args.rerun).read_text(encoding="utf-8")):
             if entry["outcome"] == "survived":
-                rerun.setdefault(entry["path"], set()).add((entry["start"], entry["end"], entry["replacement"]))
+                rerun.setdefault(entry["path"], []).append(entry)
         files = [f for f in files if f in rerun]
+        txt = Path(args.rerun).with_suffix(".txt")  # its header names the tree it ran on
+        header = txt.read_text(encoding="utf-8") if txt.exists() else ""
+        tree = next((ln.split("tree: HEAD ")[1].split()[0] for ln in header.splitlines() if "tree: HEAD " in ln), "")
+        rerun_tree = tree
     test_files = [t for t in sorted((REPO / "tests").rglob("test_*.py"))
                   if not str(t.relative_to(REPO)).startswith(SLOW_TEST_DIRS)]
     package_files = sorted(p for p in (REPO / "qtanimator").rglob("*.py") if "__pycache__" not in p.parts)
@@ -705,11 +730,20 @@ def main(argv: list[str] | None = None) -> int:
         source = (REPO / path).read_text(encoding="utf-8")
         sites = mutation_sites(source, path)
         if args.rerun:
-            chosen = [m for m in sites if (m.start, m.end, m.replacement) in rerun.get(path, set())]
-            missing = len(rerun.get(path, set())) - len(chosen)
-            if missing:
-                raise SystemExit(f"{path}: {missing} survivor(s) of {args.rerun} are not sites of the "
-                                 "current source (it changed since that run)")
+            chosen = []
+            moved = line_map(rerun_tree, path, source)
+            for entry in rerun.get(path, []):
+                # The same change of the same text on the line the old one became (the source may
+                # have moved since that run); a survivor whose line is gone is reported, not run.
+                line = moved.get(int(str(entry["line"])))
+                same = [m for m in sites if (m.line, m.operator, m.before, m.replacement) ==
+                        (line, entry["operator"], entry["before"], entry["replacement"]) and m not in chosen]
+                if same:
+                    chosen.append(same[0])
+                else:
+                    args.gone.append(f"{path}:{entry['line']}  [{entry['operator']}]  {entry['before']}  ->  "
+                                     f"{entry['after']}")
+            chosen.sort(key=lambda m: (m.start, m.end))
         else:
             chosen = sample_sites(sites, args.per_module, args.seed, path, source)
         plans.append(ModulePlan(path=path, sites=len(sites), source=source, mutants=chosen,
@@ -719,6 +753,8 @@ def main(argv: list[str] | None = None) -> int:
             print(f"# {plan.path}: {plan.sites} sites, tests: {' '.join(plan.tests)}")
             for m in plan.mutants:
                 print("  " + m.describe())
+        for g in args.gone:
+            print(f"# gone: {g}")
         return 0
 
     if SHARED.exists() and not (SHARED_LINK.is_symlink() or SHARED_LINK.exists()):

@@ -63,14 +63,13 @@ from qtanimator.core.cloth_implicit import implicit_pattern, implicit_step_numpy
 from qtanimator.core.cloth_interaction import ClothInteraction
 from qtanimator.core.cloth_params import AUTO_SUBSTEPS as AUTO_SUBSTEPS
 from qtanimator.core.cloth_params import INTEGRATORS as INTEGRATORS
-from qtanimator.core.cloth_params import PARAM_RANGES as PARAM_RANGES
 from qtanimator.core.cloth_params import PIN_MODES as PIN_MODES
 from qtanimator.core.cloth_params import SPRING_KINDS as SPRING_KINDS
 from qtanimator.core.cloth_params import ClothParams as ClothParams
 from qtanimator.core.cloth_params import Sphere as Sphere
 
 __all__ = [
-    "AUTO_SUBSTEPS", "IMPLICIT_MAX_STEP", "INTEGRATORS", "MAX_AUTO_SUBSTEPS", "PARAM_RANGES", "PIN_MODES",
+    "AUTO_SUBSTEPS", "IMPLICIT_MAX_STEP", "INTEGRATORS", "MAX_AUTO_SUBSTEPS", "PIN_MODES",
     "SOLVER_ATOL_ACCELERATION", "SOLVER_RTOL", "SPRING_KINDS", "Cloth", "ClothBlowUp", "ClothParams", "ClothState",
     "ClothStepCancelled", "Sphere", "grid_index", "nearest_particle", "pins_from_cells", "rotation_matrix",
     "vertex_normals",

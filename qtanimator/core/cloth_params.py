@@ -11,22 +11,12 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any, NamedTuple
 
-__all__ = ["AUTO_SUBSTEPS", "INTEGRATORS", "PARAM_RANGES", "PIN_MODES", "SPRING_KINDS", "ClothParams", "Sphere",
+__all__ = ["AUTO_SUBSTEPS", "INTEGRATORS", "PIN_MODES", "SPRING_KINDS", "ClothParams", "Sphere",
            "Vec3"]
 
 PIN_MODES = ("top_corners", "top_edge", "none", "custom")
 INTEGRATORS = ("symplectic", "implicit")
 SPRING_KINDS = ("structural", "shear", "bend")
-
-#: Suggested editor ranges (min, max) for numeric parameters, after notes/cse169-formats.md §11.
-PARAM_RANGES: dict[str, tuple[float, float]] = {
-    "rows": (2, 128), "cols": (2, 128), "width": (0.05, 20.0), "height": (0.05, 20.0), "total_mass": (0.001, 100.0),
-    "structural_stiffness": (0.0, 1.0e5), "shear_stiffness": (0.0, 1.0e5), "bend_stiffness": (0.0, 1.0e5),
-    "structural_damping": (0.0, 50.0), "shear_damping": (0.0, 50.0), "bend_damping": (0.0, 50.0),
-    "drag_coefficient": (0.0, 2.0), "air_density": (0.0, 2.0), "turbulence": (0.0, 20.0), "gravity": (0.0, 20.0),
-    "ground_height": (-10.0, 10.0), "ground_restitution": (0.0, 1.0), "ground_friction": (0.0, 2.0),
-    "collision_margin": (0.0, 0.1), "substeps": (0, 200),
-}
 
 #: ``substeps`` = AUTO_SUBSTEPS lets the cloth choose its steps per frame (see :mod:`qtanimator.core.cloth`).
 AUTO_SUBSTEPS = 0

@@ -198,3 +198,19 @@ def test_a_particle_inside_a_capsule_moving_out_keeps_its_velocity(speed: float)
     collide(p, x, v, [], (a, b, r), NONE)
     np.testing.assert_allclose(x[0], [2.0, 1.2, 1.0], rtol=1e-11)
     np.testing.assert_array_equal(v[0], [0.0, speed, 0.25])
+
+
+def test_kinematic_particles_ignore_spheres() -> None:
+    """Kinematic particles never collide (module docstring): a pinned particle 0 at a sphere's
+    centre and a pinned particle 1 far outside keep their places and velocities, while the
+    free particle 2 at c + (0.3, 0, 0) is pushed to the surface, c + (radius + margin)·x̂ =
+    c + (0.5 + 0.1, 0, 0)."""
+    p = ClothParams(ground_enabled=False, collision_margin=0.1)
+    centre = np.array([1.0, 2.0, 3.0])
+    x = np.array([[1.0, 2.0, 3.0], [9.0, 9.0, 9.0], [1.3, 2.0, 3.0]])
+    v = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
+    x0, v0 = x.copy(), v.copy()
+    collide(p, x, v, [(centre, 0.5, 0.0, 0.0)], None, np.array([0, 1]))
+    np.testing.assert_array_equal(x[:2], x0[:2])
+    np.testing.assert_array_equal(v[:2], v0[:2])
+    np.testing.assert_allclose(x[2], [1.6, 2.0, 3.0], rtol=1e-9)

@@ -19,7 +19,7 @@ from qtanimator.core.cloth_forces import drag_rate, stable_dt, turbulence_modes,
 from qtanimator.core.cloth_grid import vertex_normals
 from qtanimator.core.cloth_implicit import implicit_pattern
 from qtanimator.core.cloth_kernels import HAVE_NUMBA
-from qtanimator.core.cloth_params import PARAM_RANGES
+from qtanimator.document.parameters import CLOTH
 
 ACCELERATE = [False, pytest.param(True, marks=pytest.mark.skipif(not HAVE_NUMBA, reason="numba not installed"))]
 
@@ -255,7 +255,7 @@ def test_vertex_normals_are_unit_even_without_area() -> None:
 
 def test_the_smallest_grid_the_editor_offers_is_the_smallest_valid_one() -> None:
     for name in ("rows", "cols"):
-        lo = int(PARAM_RANGES[name][0])
+        lo = int(CLOTH[name].minimum or 0)
         ClothParams(**{name: lo}).validate()
         with pytest.raises(ValueError):
             ClothParams(**{name: lo - 1}).validate()
@@ -263,7 +263,8 @@ def test_the_smallest_grid_the_editor_offers_is_the_smallest_valid_one() -> None
 
 def test_the_three_spring_kinds_share_their_ranges() -> None:
     for what in ("stiffness", "damping"):
-        ranges = {PARAM_RANGES[f"{kind}_{what}"] for kind in ("structural", "shear", "bend")}
+        params = [CLOTH[f"{kind}_{what}"] for kind in ("structural", "shear", "bend")]
+        ranges = {(p.minimum, p.maximum) for p in params}
         assert len(ranges) == 1
 
 
@@ -407,3 +408,12 @@ def test_auto_substeps_are_refused_past_5000_not_at_5000() -> None:
         cloth.step(5000.5 * limit)
     assert info.value.parameter == "integrator"
     np.testing.assert_array_equal(cloth.positions, before)
+
+
+def test_no_solver_iterations_before_an_implicit_step() -> None:
+    """``last_iterations`` counts the conjugate-gradient iterations of the last implicit
+    substep: a new cloth has solved nothing (0), and symplectic steps solve nothing either."""
+    cloth = Cloth(ClothParams(rows=3, cols=3, integrator="symplectic", substeps=1))
+    assert cloth.last_iterations == 0
+    cloth.step(1.0 / 60.0)
+    assert cloth.last_iterations == 0

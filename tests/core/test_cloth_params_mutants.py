@@ -8,25 +8,35 @@ from dataclasses import fields
 
 import pytest
 
-from qtanimator.core.cloth_params import AUTO_SUBSTEPS, PARAM_RANGES, ClothParams, Sphere
+from qtanimator.core.cloth_params import AUTO_SUBSTEPS, ClothParams, Sphere
+from qtanimator.document.parameters import CLOTH
 
 NON_NEGATIVE = ("structural_stiffness", "structural_damping", "shear_stiffness", "shear_damping", "bend_stiffness",
                 "bend_damping", "drag_coefficient", "air_density", "turbulence", "ground_restitution",
                 "ground_friction", "collision_margin")
 
 
+def _number_ranges() -> dict[str, tuple[float, float]]:
+    """The schema's (document/parameters.py) range of every numeric cloth setting."""
+    return {key: (p.minimum, p.maximum) for key, p in CLOTH.items()
+            if p.minimum is not None and p.maximum is not None and p.kind not in ("vector", "list")}
+
+
 def test_every_default_lies_inside_its_editor_range() -> None:
     """An editor must be able to show the default value: lo ≤ default ≤ hi, lo < hi."""
     defaults = ClothParams()
-    for name, (lo, hi) in PARAM_RANGES.items():
+    ranges = _number_ranges()
+    assert {"rows", "cols", "ground_restitution", "substeps", "gravity"} <= set(ranges)
+    for name, (lo, hi) in ranges.items():
         assert lo < hi, name
         assert lo <= getattr(defaults, name) <= hi, name
 
 
 def test_every_range_end_is_a_valid_setting() -> None:
-    for name, (lo, hi) in PARAM_RANGES.items():
+    for name, (lo, hi) in _number_ranges().items():
         for value in (lo, hi):
-            ClothParams(**{name: int(value) if name in ("rows", "cols", "substeps") else value}).validate()
+            ClothParams(**{name: int(value) if name in ("rows", "cols", "substeps", "turbulence_seed")
+                           else value}).validate()
 
 
 @pytest.mark.parametrize("name", NON_NEGATIVE)
@@ -145,3 +155,9 @@ def test_the_defaults_are_the_user_guides() -> None:
     assert (p.gravity, p.ground_enabled, p.ground_height) == (9.8, True, 0.0)
     assert (p.pin_mode, p.integrator, p.substeps) == ("top_corners", "implicit", AUTO_SUBSTEPS)
     assert AUTO_SUBSTEPS == 0
+
+
+def test_the_ground_restitution_range_never_gains_energy() -> None:
+    """A restitution above 1 would make a bounce faster than the impact (energy from nowhere);
+    the document schema (document/parameters.py) caps it at 1 as well."""
+    assert (CLOTH["ground_restitution"].minimum, CLOTH["ground_restitution"].maximum) == (0.0, 1.0)

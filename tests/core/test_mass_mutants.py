@@ -13,6 +13,7 @@ import pytest
 from qtanimator.core.mass import (
     MassProperties,
     combine,
+    point_properties,
     polygon_properties,
     polyline_properties,
     reference_shape_mass_properties,
@@ -119,3 +120,13 @@ def test_point_shape_is_a_point_mass_of_its_stroke_alpha() -> None:
     for props in (shape_mass_properties(pt, [0.0, 0.0]), reference_shape_mass_properties(pt, [0.0, 0.0])):
         assert props.mass == 2.0 and props.inertia == pytest.approx(50.0)
         np.testing.assert_array_equal(props.centroid, [3.0, 4.0])
+
+
+def test_point_mass_moment_about_a_pivot_away_from_the_origin() -> None:
+    """A point mass m at q has I = m·|q − c|² about c: m = 2 at (4, 6) about (1, 2) gives
+    2·(3² + 4²) = 50; at its own pivot it has none."""
+    mp = point_properties((4.0, 6.0), 2.0, (1.0, 2.0))
+    assert mp.mass == 2.0
+    assert mp.inertia == pytest.approx(50.0, rel=1e-12)
+    np.testing.assert_array_equal(mp.centroid, [4.0, 6.0])
+    assert point_properties((1.0, 2.0), 3.0, (1.0, 2.0)).inertia == 0.0

@@ -247,3 +247,13 @@ def test_given_mass_properties_are_kept() -> None:
     assert ch.joints[0].mass_properties is given and ch.joints[0].reference_mass_properties is ref
     assert ch.joints[1].mass_properties is not None and ch.joints[1].mass_properties.mass == 0.0
     assert ch.joints[1].reference_mass_properties is not None and ch.joints[1].reference_mass_properties.mass == 0.0
+
+
+def test_character_bounds_include_half_the_stroke_on_every_side() -> None:
+    """The square 1…5 × 2…8 with a visible stroke 4 wide reaches 2 further on every side:
+    (−1, 0, 7, 10), the same as Shape.bounds; posed at +(10, 20) it is (9, 20, 17, 30)."""
+    shape = Shape(SQUARE.copy(), True, stroke=(0.0, 0.0, 0.0, 1.0), stroke_width=4.0)
+    ch = Character("s", [Joint("a", None, np.array([2.0, 3.0]), shapes=[shape])])
+    assert ch.bounds() == (-1.0, 0.0, 7.0, 10.0)
+    assert ch.bounds() == shape.bounds()
+    assert ch.bounds(ch.pose([0.0], (10.0, 20.0))) == pytest.approx((9.0, 20.0, 17.0, 30.0), abs=1e-12)
