@@ -137,3 +137,41 @@ def test_columns_share_equal_numbers_but_keep_minus_zero_apart():
     assert isinstance(col, list) and [math.copysign(1.0, s) for s in col] == [1.0, -1.0]
     back = Channel.from_dict(signed.to_dict(columns=True))
     assert math.copysign(1.0, back.keys[1].in_slope) == -1.0
+
+
+# ---- surv4: key_index's tolerance is inclusive; unweighted() keeps to max_keys
+
+
+def test_key_index_tolerance_is_inclusive():
+    # "within tolerance" includes the bound: 0.75 − 0.5 = 0.25 exactly in binary, and a
+    # zero tolerance still finds a key at exactly that time.
+    ch = Channel([Key(0.5, 1.0), Key(2.0, 3.0)])
+    assert ch.key_index(0.75, tolerance=0.25) == 0
+    assert ch.key_index(2.0, tolerance=0.0) == 1
+    assert ch.key_index(0.75, tolerance=0.125) is None
+    # set_key with a zero tolerance replaces the key at that exact time (no second key).
+    assert len(ch.set_key(Key(2.0, 7.0), tolerance=0.0).keys) == 2
+
+
+def test_unweighted_adds_no_more_than_max_keys(monkeypatch):
+    import qtanimator.core.channel as channel_module
+
+    calls = [0]
+    real = channel_module.hermite
+
+    def counted(*args, **kw):   # a cut-off for a subdivision that never stops
+        calls[0] += 1   # one call per round of cutting, one row per piece
+        if calls[0] > 50 or len(args[0]) > 64:
+            raise RuntimeError("unweighted() kept subdividing past max_keys")
+        return real(*args, **kw)
+
+    monkeypatch.setattr(channel_module, "hermite", counted)
+    # A weighted span far from its Hermite (long out handle, short in handle) against an
+    # unreachable tolerance: only max_keys stops the cutting.
+    ch = Channel([Key(0.0, 0.0, "fixed", "fixed", 0.0, 10.0, out_weight=0.9),
+                  Key(1.0, 1.0, "fixed", "fixed", 10.0, 0.0, in_weight=0.05)])
+    assert ch.is_weighted
+    for cap in (0, 1, 3):
+        out, added, _worst = ch.unweighted(tolerance=1e-300, max_keys=cap)
+        assert added <= cap
+        assert len(out.keys) == 2 + added

@@ -218,3 +218,17 @@ def test_two_bone_closed_form_with_a_zero_length_bone_returns_two_finite_angles(
     documented pair of angles (no division by zero, no NaN)."""
     first, turn = two_bone_closed_form(upper, lower, 0.5)
     assert math.isfinite(first) and math.isfinite(turn)
+
+
+# ---- surv4: StallCheck's default window is three sweeps
+
+
+def test_stall_check_default_window_is_three_sweeps():
+    # STALL_FRACTION's doc: "Three sweeps or passes that together gain less than three times
+    # this fraction of the tolerance end the solve". No gain at all: the third repeat stops it.
+    from qtanimator.core.ik_methods import STALL_FRACTION, StallCheck
+
+    check = StallCheck(1.0, 1.0)
+    assert check.window == 3
+    assert check.limit == pytest.approx(3 * STALL_FRACTION)
+    assert [check(1.0) for _ in range(3)] == [False, False, True]

@@ -82,3 +82,16 @@ def test_series_with_only_out_slopes_is_fixed_and_without_slopes_linear():
     assert [k.time for k in keys] == [0.0, 1.0, 2.0]
     assert all(k.in_tangent is Tangent.LINEAR for k in keys)
     assert keys[1] == Key(1.0, 2.0, "linear", "linear", interpolation="linear")
+
+
+# ---- surv4: a clamped extremum whose secants' product underflows
+
+
+def test_clamped_slope_is_zero_at_a_tiny_extremum():
+    # docs/decisions.md: clamped tangents are "zero at a local extremum". Here the middle key
+    # is a peak (secants +1e-200 and -2e-200) whose secant product (-2e-400) underflows to
+    # -0.0; the peak must still be flat, not the smooth slope (-1e-200 - 0) / 2 = -5e-201.
+    ch = Channel([Key(0.0, 0.0, "clamped", "clamped"), Key(1.0, 1e-200, "clamped", "clamped"),
+                  Key(2.0, -1e-200, "clamped", "clamped")])
+    s_in, s_out = ch.slopes()
+    assert s_in[1] == 0.0 and s_out[1] == 0.0
