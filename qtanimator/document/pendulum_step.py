@@ -49,6 +49,16 @@ def keyed_angles_at(channels: Mapping[str, Channel], asset_id: str, ch: Characte
     return out
 
 
+def keyed_translation_accelerations(channels: Mapping[str, Channel], asset_id: str, times: FloatArray) -> FloatArray:
+    """(len(times), 2): the keyed acceleration of the character's position (x, y) at ``times``."""
+    out = np.zeros((len(times), 2))
+    for col, cid in enumerate(position_channel_ids(asset_id)):
+        chn = channels.get(cid)
+        if chn is not None and chn.keys:
+            out[:, col] = chn.evaluate(times, 2)
+    return out
+
+
 def new_sim(doc: Document, asset_id: str, ch: Character) -> AssetSim:
     limits = joint_limits(doc, asset_id) if ch.simulated.any() else None
     return AssetSim(ch, pendulum_params(doc, asset_id), limits,
@@ -162,31 +172,14 @@ def advance(doc: Document, asset_id: str, sim: AssetSim, frame: int, theta0: Flo
     t0, t1 = frame / fps, (frame + 1) / fps
     n_steps = max(1, int(round((t1 - t0) / params.step)))
     tau = (t1 - t0) / n_steps
-    times = t0 + tau * np.arange(n_steps)
+    times = np.asarray(t0 + tau * np.arange(n_steps), dtype=np.float64)
     theta, omega = theta0.copy(), omega0.copy()
     dyn_idx = np.flatnonzero(ch.dynamic)
     # Channel values and derivatives at every sub-step time, evaluated at once.
-    ang = np.zeros((3, n_steps, len(ch.joints)))
     stored = doc.parameters
     limits = [limit_pair(stored.get(limits_parameter(asset_id, j.name))) for j in ch.joints]
-    for k, j in enumerate(ch.joints):
-        if j.is_dynamic:
-            continue
-        chn = channels.get(angle_channel_id(asset_id, j.name))
-        if chn is not None and chn.keys:
-            for d in range(3):
-                ang[d, :, k] = chn.evaluate(times, d)
-        lim = limits[k]
-        if lim is not None:  # as keyframed_angles: clamped, still while clamped
-            held = (ang[0, :, k] < lim[0]) | (ang[0, :, k] > lim[1])
-            ang[0, :, k] = np.clip(ang[0, :, k], lim[0], lim[1])
-            ang[1:, held, k] = 0.0
-    cx, cy = position_channel_ids(asset_id)
-    tacc = np.zeros((n_steps, 2))
-    for col, cid in enumerate((cx, cy)):
-        chn = channels.get(cid)
-        if chn is not None and chn.keys:
-            tacc[:, col] = chn.evaluate(times, 2)
+    ang = keyed_angles_at(channels, asset_id, ch, times, limits)
+    tacc = keyed_translation_accelerations(channels, asset_id, times)
     # Keyframed parts of the world angles, rates and accelerations for every sub-step.
     w_key = ang[0] @ sim.key_sum.T
     r_key = ang[1] @ sim.key_sum.T
@@ -196,11 +189,7 @@ def advance(doc: Document, asset_id: str, sim: AssetSim, frame: int, theta0: Flo
     if springs is not None:  # keys and the body's acceleration at the sub-steps' midpoints
         mids = np.asarray(times + 0.5 * tau, dtype=np.float64)
         mid = keyed_angles_at(channels, asset_id, ch, mids, limits)
-        tacc_mid = np.zeros((n_steps, 2))
-        for col, cid in enumerate((cx, cy)):
-            chn = channels.get(cid)
-            if chn is not None and chn.keys:
-                tacc_mid[:, col] = chn.evaluate(mids, 2)
+        tacc_mid = keyed_translation_accelerations(channels, asset_id, mids)
     if bounded:  # limits: the parents' motion to the frame's end
         end = keyed_angles_at(channels, asset_id, ch, np.array([t1]), limits)[:, 0]
     tacc = tacc * params.accel_scale
