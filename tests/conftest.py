@@ -4,7 +4,9 @@ At import time we try to start ``Xvfb -displayfd``. When it starts, every Qt tes
 the ``xcb`` platform on that private display, so QOpenGLWidget gets a real Mesa (llvmpipe)
 context. When it cannot start, widgets run on the ``offscreen`` platform and the tests
 marked ``gl`` are skipped with the reason; in CI (``CI=true``) they fail instead, as do the
-tests that need ``../shared/data`` when it is missing (see ``tests/needs.py``).
+tests that need the sample data (``$QTANIMATOR_SHARED_DATA`` or ``../shared/data``) when it is
+missing (see ``tests/needs.py``). The run ends with one line that says how many tests were
+skipped (or failed, in CI) for want of the sample data, and where it was looked for.
 
 Hypothesis runs with the ``ci`` profile (fixed seeds) when ``CI=true`` and ``dev`` otherwise
 (``tests/hypothesis_profiles.py``).
@@ -18,12 +20,9 @@ from pathlib import Path
 
 import hypothesis_profiles
 import pytest
-from needs import missing
+from needs import SHARED_DATA_MISSING, in_ci, missing, shared_data_missing_reason, shared_data_path
 
 from qtanimator.render.xvfb import start_private_xvfb
-
-REPO = Path(__file__).resolve().parents[1]
-SHARED_DATA = (REPO / ".." / "shared" / "data").resolve()
 
 _xvfb_reason = ""
 
@@ -69,10 +68,39 @@ def pytest_runtest_setup(item: pytest.Item) -> None:
 
 @pytest.fixture(scope="session")
 def shared_data() -> Path:
-    """The real public sample files; tests using this skip when they are absent (fail in CI)."""
-    if not SHARED_DATA.is_dir():
-        missing(f"shared sample data not found at {SHARED_DATA}")
-    return SHARED_DATA
+    """The real public sample files; tests using this skip when they are absent (fail in CI).
+    The folder is ``$QTANIMATOR_SHARED_DATA`` or ``../shared/data`` (``tests/needs.py``)."""
+    return shared_data_path()
+
+
+def _for_want_of_sample_data(report: pytest.TestReport | pytest.CollectReport) -> bool:
+    longrepr = report.longrepr
+    text = longrepr[2] if isinstance(longrepr, tuple) else str(longrepr)
+    return SHARED_DATA_MISSING in text
+
+
+@pytest.hookimpl(wrapper=True, tryfirst=True)
+def pytest_terminal_summary(terminalreporter, exitstatus, config):  # type: ignore[no-untyped-def]
+    """One line: how many tests were skipped (failed, in CI) because the sample data is missing.
+    A wrapper around pytest's own summary, so that the line comes after the short test summary,
+    just before the counts."""
+    try:
+        return (yield)
+    finally:
+        _sample_data_line(terminalreporter)
+
+
+def _sample_data_line(terminalreporter) -> None:  # type: ignore[no-untyped-def]
+    reason = shared_data_missing_reason()
+    if reason is None:
+        return
+    # In CI a fixture that fails is counted as an error, a test body that fails as a failure.
+    what, kinds = ("failed", ("failed", "error")) if in_ci() else ("skipped", ("skipped",))
+    count = sum(1 for kind in kinds for report in terminalreporter.stats.get(kind, [])
+                if _for_want_of_sample_data(report))
+    if count:
+        tests = "test" if count == 1 else "tests"
+        terminalreporter.write_line(f"qtanimator: {count} {tests} {what}: {reason}")
 
 
 @pytest.fixture(autouse=True)

@@ -67,11 +67,9 @@ def test_small_angle_period() -> None:
 
 def test_period_of_a_real_clock_pendulum_with_reference_moments() -> None:
     # notes 9.4: handout 3A (g = 3, reference I) gives about 1.13 s for clock joint 5
-    from pathlib import Path
+    from needs import shared_data_path
 
-    root = Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "cmu-animator" / "scenes"
-    if not root.is_dir():
-        pytest.skip("shared sample data not found")
+    root = shared_data_path("cmu-animator", "scenes")
     from qtanimator.formats.svg_rig import load_characters
 
     [clock] = load_characters(root / "clock.svg")

@@ -2,8 +2,9 @@
 
 The cases are the small generated files of ``tests/gltf_gen.py`` (one per row of the issue,
 plus a small :func:`gltf_gen.big_clip`) and every ``.gltf`` / ``.glb`` in the shared sample
-folder ``../shared/data/gltf`` (CesiumMan, RiggedFigure, RiggedSimple and SimpleSkin must be
-there: a missing file fails, it is never skipped).
+folder ``gltf`` of the sample data (``tests/needs.py``: CesiumMan, RiggedFigure, RiggedSimple and
+SimpleSkin must be there: a missing file fails; without the sample data at all they skip, and
+fail in CI).
 
 The reference is ``tests/gltf_spec.py``, an evaluation of the glTF 2.0 specification that
 shares no code with the program. For every animation of every case, at every key time and at
@@ -30,6 +31,7 @@ import gltf_gen
 import gltf_spec as spec
 import numpy as np
 import pytest
+from needs import shared_data_dir, shared_data_path
 
 from qtanimator.document import Document, UndoStack, open_document, save_document
 
@@ -39,9 +41,10 @@ TOLERANCE = 1e-5
 MAX_TIMES = 60
 #: Samples that must be present (every other .gltf / .glb in the folder is checked too).
 SAMPLES = ("CesiumMan.glb", "RiggedFigure.glb", "RiggedSimple.glb", "SimpleSkin.gltf")
-#: The folder tests/conftest.py's ``shared_data`` fixture points at; that fixture skips when
-#: the folder is missing, and here a missing sample must fail, so the path is used directly.
-SAMPLE_DIR = (Path(__file__).resolve().parents[2] / ".." / "shared" / "data" / "gltf").resolve()
+#: The samples' folder (read at import time for the list of cases; each case that reads it goes
+#: through ``shared_data_path``: skipped without the sample data, failed in CI; once the data is
+#: there, a missing sample fails).
+SAMPLE_DIR = shared_data_dir() / "gltf"
 
 
 def _small_big_clip(folder: Path) -> Path:
@@ -64,7 +67,7 @@ def model(request: pytest.FixtureRequest, generated: dict[str, Path]) -> Path:
     kind, name = request.param.split("/", 1)
     if kind == "generated":
         return generated[name]
-    path = SAMPLE_DIR / name
+    path = shared_data_path("gltf", name)
     assert path.is_file(), f"shared sample {path} is missing"
     return path
 

@@ -20,6 +20,7 @@ from pathlib import Path
 import bvhio  # a test dependency: missing is an error, not a skip
 import numpy as np
 import pytest
+from needs import shared_data_dir, shared_data_params, shared_data_path
 from samples import BLENDER_BVH
 
 from qtanimator.core.clip import apply_clip
@@ -27,9 +28,16 @@ from qtanimator.document.character3d import load_bvh_character
 from qtanimator.formats import FormatError
 from qtanimator.formats.bvh import detect_positions, load_bvh, parse_bvh
 
-DATA = Path(__file__).resolve().parents[3] / "shared" / "data" / "bvh"
-SAMPLES = sorted(DATA.glob("*.bvh")) if DATA.is_dir() else []
-CMU = DATA / "cmu_12_01_walk.bvh"
+#: The sample BVH files (``tests/needs.py``): every one is compared with bvhio; without the
+#: sample data the list is one placeholder that the test skips (fails in CI).
+DATA = shared_data_dir() / "bvh"
+SAMPLES = shared_data_params(sorted(DATA.glob("*.bvh")), DATA / "*.bvh")
+
+
+@pytest.fixture
+def cmu() -> Path:
+    """The CMU walk (relative root positions, feet on the floor)."""
+    return shared_data_path("bvh", "cmu_12_01_walk.bvh")
 
 
 # ------------------------------------------------------------------ writing files
@@ -144,6 +152,7 @@ def _assert_same(ours: np.ndarray, ref: np.ndarray, path: Path) -> None:
 # ------------------------------------------------------------------------- tests
 @pytest.mark.parametrize("path", SAMPLES, ids=lambda p: p.name)
 def test_shared_samples_equal_bvhio(path: Path, tmp_path: Path) -> None:
+    shared_data_path()
     frames = _frames(path)
     clip = load_bvh(path)
     ref = _bvhio_positions(path if clip.positions == "absolute" else _absolute_equivalent(path, tmp_path / "a.bvh"),
@@ -157,7 +166,7 @@ def test_shared_samples_equal_bvhio(path: Path, tmp_path: Path) -> None:
 def test_six_channels_per_joint_like_blender(name: str, tmp_path: Path) -> None:
     """Blender's exporter: 6 channels on every joint, positions equal to the OFFSET
     (absolute), the root's first position at its OFFSET."""
-    src = DATA / name
+    src = shared_data_path("bvh", name)
     clip = load_bvh(src)
     first = clip.motion[0, :3] if clip.joints[0].channels[0].endswith("position") else clip.motion[0, 3:6]
     path = _rewrite(src, tmp_path / "blender.bvh", root_offset=tuple(float(v) for v in first),
@@ -171,9 +180,9 @@ def test_six_channels_per_joint_like_blender(name: str, tmp_path: Path) -> None:
     assert character.positions == "absolute" and "absolute" in character.notes[0]
 
 
-def test_relative_positions_on_every_joint(tmp_path: Path) -> None:
+def test_relative_positions_on_every_joint(cmu: Path, tmp_path: Path) -> None:
     """Position channels of 0 on every joint, root relative: the documented relative reading."""
-    path = _rewrite(CMU, tmp_path / "rel6.bvh", root_offset=(0.0, 16.0, 0.0), shift_root=(0.0, -16.0, 0.0),
+    path = _rewrite(cmu, tmp_path / "rel6.bvh", root_offset=(0.0, 16.0, 0.0), shift_root=(0.0, -16.0, 0.0),
                     positions_everywhere=True, absolute_children=False, frames=40)
     assert load_bvh(path).positions == "relative"
     frames = _frames(path, 5)
@@ -181,8 +190,8 @@ def test_relative_positions_on_every_joint(tmp_path: Path) -> None:
     _assert_same(_character_positions(path, frames), ref, path)
 
 
-def test_a_joint_that_really_moves_gets_translation_channels(tmp_path: Path) -> None:
-    path = _rewrite(CMU, tmp_path / "moving.bvh", positions_everywhere=True, frames=10)
+def test_a_joint_that_really_moves_gets_translation_channels(cmu: Path, tmp_path: Path) -> None:
+    path = _rewrite(cmu, tmp_path / "moving.bvh", positions_everywhere=True, frames=10)
     text = path.read_text().splitlines()
     head_end = text.index("MOTION")
     clip = load_bvh(path)
@@ -199,14 +208,14 @@ def test_a_joint_that_really_moves_gets_translation_channels(tmp_path: Path) -> 
 
 
 @pytest.mark.parametrize("extra", [["0 " * 96], ["0 " * 96, "1 2 3"], ["KEYS 1 2", "Hips 3 4"]])
-def test_rows_after_the_declared_frames_are_ignored_with_a_warning(extra: list[str], tmp_path: Path) -> None:
-    path = _rewrite(CMU, tmp_path / "extra.bvh", frames=30, extra_rows=extra)
+def test_rows_after_the_declared_frames_are_ignored_with_a_warning(cmu: Path, extra: list[str], tmp_path: Path) -> None:
+    path = _rewrite(cmu, tmp_path / "extra.bvh", frames=30, extra_rows=extra)
     clip = load_bvh(path)
     assert clip.frame_count == 30
     n = len(extra)
     assert clip.warnings == [f"{n} row{'s' if n > 1 else ''} after the declared 30 frames "
                              f"{'were' if n > 1 else 'was'} ignored."]
-    np.testing.assert_array_equal(clip.motion, load_bvh(CMU).motion[:30])
+    np.testing.assert_array_equal(clip.motion, load_bvh(cmu).motion[:30])
     frames = _frames(path, 3)
     _assert_same(_character_positions(path, frames), _bvhio_positions(path, frames), path)
     character, _ = load_bvh_character(path)
@@ -231,15 +240,15 @@ def _height_and_floor(path: Path, positions: str | None = None) -> tuple[float, 
 
 
 @pytest.mark.parametrize("convention", ["as-is", "absolute", "relative"])
-def test_walking_feet_stay_on_the_floor_in_both_conventions(convention: str, tmp_path: Path) -> None:
-    clip = load_bvh(CMU)
+def test_walking_feet_stay_on_the_floor_in_both_conventions(cmu: Path, convention: str, tmp_path: Path) -> None:
+    clip = load_bvh(cmu)
     hip = float(clip.motion[0, 1])
     if convention == "as-is":
-        path = CMU
+        path = cmu
     elif convention == "absolute":  # OFFSET = the hip's rest height, positions as captured
-        path = _rewrite(CMU, tmp_path / "abs.bvh", root_offset=(0.0, hip, 0.0))
+        path = _rewrite(cmu, tmp_path / "abs.bvh", root_offset=(0.0, hip, 0.0))
     else:  # OFFSET = the hip's rest height, positions near zero
-        path = _rewrite(CMU, tmp_path / "rel.bvh", root_offset=(0.0, hip, 0.0), shift_root=(0.0, -hip, 0.0))
+        path = _rewrite(cmu, tmp_path / "rel.bvh", root_offset=(0.0, hip, 0.0), shift_root=(0.0, -hip, 0.0))
     expected = {"as-is": "relative", "absolute": "absolute", "relative": "relative"}[convention]
     assert detect_positions(load_bvh(path)) == expected
     height, lowest = _height_and_floor(path)

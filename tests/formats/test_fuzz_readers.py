@@ -15,6 +15,7 @@ from typing import Any
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from needs import shared_data_path
 
 from qtanimator.formats import FormatError
 from qtanimator.formats.anim import load_anim
@@ -29,7 +30,6 @@ from qtanimator.formats.skin import load_skin
 from qtanimator.formats.svg_rig import load_characters
 
 REPO = Path(__file__).resolve().parents[2]
-DATA = REPO.parent / "shared" / "data"
 OBJ = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nvt 0 0\nf 1/1/1 2/1/1 3/1/1\nf 2 4 3\n"
 ATTACH = b"0.5 0.5 0\n1 0 0\n0 1 0\n0.25 0.25 0.5\n"
 SKIN = (b"positions 3 {\n 0 0 0\n 1 0 0\n 0 1 0\n}\nnormals 3 {\n 0 0 1\n 0 0 1\n 0 0 1\n}\n"
@@ -37,18 +37,19 @@ SKIN = (b"positions 3 {\n 0 0 0\n 1 0 0\n 0 1 0\n}\nnormals 3 {\n 0 0 1\n 0 0 1\
         b"bindings 2 {\n matrix {\n 1 0 0\n 0 1 0\n 0 0 1\n 0 0 0\n }\n"
         b" matrix {\n 1 0 0\n 0 1 0\n 0 0 1\n 0 1 0\n }\n}\n")
 
-#: suffix → (reader, where the seed file comes from: a path, or bytes)
-SEEDS: dict[str, tuple[Callable[[Path], Any], Path | bytes]] = {
+#: suffix → (reader, where the seed file comes from: a path in the repository, a path inside
+#: the sample data as a string (``tests/needs.py``: skipped without it, failed in CI), or bytes)
+SEEDS: dict[str, tuple[Callable[[Path], Any], Path | str | bytes]] = {
     ".anim": (load_anim, REPO / "scenes" / "arm3d" / "arm_wave.anim"),
     ".skel": (load_skel, REPO / "scenes" / "arm3d" / "arm.skel"),
     ".skin": (load_skin, SKIN),
     ".obj": (load_obj, OBJ),
     ".attach": (lambda p: load_attach(p, 4, 4), ATTACH),
-    ".morph": (load_morph, DATA / "cse169" / "head" / "head2.morph"),
-    ".bvh": (load_bvh, DATA / "bvh" / "pybvh_rotation_first_root.bvh"),
-    ".gltf": (import_gltf, DATA / "gltf" / "SimpleSkin.gltf"),
-    ".glb": (import_gltf, DATA / "gltf" / "RiggedSimple.glb"),
-    ".svg": (load_characters, DATA / "cmu-animator" / "scenes" / "arm.svg"),
+    ".morph": (load_morph, "cse169/head/head2.morph"),
+    ".bvh": (load_bvh, "bvh/pybvh_rotation_first_root.bvh"),
+    ".gltf": (import_gltf, "gltf/SimpleSkin.gltf"),
+    ".glb": (import_gltf, "gltf/RiggedSimple.glb"),
+    ".svg": (load_characters, "cmu-animator/scenes/arm.svg"),
     ".qtanim": (load_project, REPO / "scenes" / "flappy_hop.qtanim"),
 }
 
@@ -80,6 +81,8 @@ def mutate(data: bytes, ops: list[tuple[str, float, int, int]]) -> bytes:
 @pytest.mark.parametrize("suffix", sorted(SEEDS))
 def test_mutated_files_give_format_error_only(tmp_path: Path, suffix: str) -> None:
     reader, source = SEEDS[suffix]
+    if isinstance(source, str):
+        source = shared_data_path(source)
     seed = source if isinstance(source, bytes) else source.read_bytes()
     reader(_write(tmp_path, suffix, seed))  # the seed itself reads
 

@@ -122,8 +122,6 @@ def test_character_row_moves_and_reset_pose(qtbot, clock):
 
 def test_3d_skeleton_joints_and_dof_limits(make_window, qtbot, shared_data):
     skel = shared_data / "cse169" / "skeleton" / "wasp.skel"
-    if not skel.exists():
-        pytest.skip("no wasp.skel")
     from qtanimator.document import character3d as c3d
 
     window = make_window()
