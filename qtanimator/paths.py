@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 _PACKAGE = Path(__file__).resolve().parent
@@ -20,6 +21,25 @@ def resources_dir() -> Path:
 
 def scenes_dir() -> Path:
     return _first_existing(_PACKAGE / "scenes", _PACKAGE.parent / "scenes")
+
+
+def sample_dirs() -> list[Path]:
+    """The folders of bundled sample scenes: the installed package's ``qtanimator/scenes``
+    and, in a checkout, the repository's ``scenes/`` (resolved; only those that exist)."""
+    candidates = [_PACKAGE / "scenes"]
+    if (_PACKAGE.parent / "pyproject.toml").is_file():  # a checkout, not site-packages
+        candidates.append(_PACKAGE.parent / "scenes")
+    return [c.resolve() for c in candidates if c.is_dir()]
+
+
+def is_sample(path: str | os.PathLike[str]) -> bool:
+    """True for a file or folder inside a bundled samples folder (:func:`sample_dirs`):
+    the program opens such a project as an untitled copy and never writes into it."""
+    try:
+        resolved = Path(path).resolve()
+    except (OSError, RuntimeError, ValueError):
+        return False
+    return any(resolved.is_relative_to(folder) for folder in sample_dirs())
 
 
 def shader_path(name: str) -> Path:

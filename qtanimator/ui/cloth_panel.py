@@ -20,6 +20,7 @@ from PySide6.QtWidgets import (
     QCheckBox,
     QComboBox,
     QFormLayout,
+    QGridLayout,
     QHBoxLayout,
     QLabel,
     QLineEdit,
@@ -35,6 +36,7 @@ from qtanimator.document.document import DocumentChange
 from qtanimator.document.parameters import CLOTH, CLOTH_SPHERE_CENTRE, CLOTH_SPHERE_RADIUS, CLOTH_WIND_SPEED, Param
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.param_fields import ParamDoubleSpinBox, ParamSpinBox, editor_for, spin_for
+from qtanimator.ui.widgets import wrap_long_rows
 
 _gestures = itertools.count(1)
 
@@ -82,7 +84,16 @@ class ClothPanel(QWidget):
         self.editors: dict[str, Any] = {}
         self._updating = False
         self._gesture: tuple[str, int] | None = None
-        outer = QVBoxLayout(self)
+        # Everything scrolls, the buttons with the form (as in Blender's property editor):
+        # the dock can then be short, a tab on a 768-pixel-high screen (issue 30).
+        scroll = QScrollArea(self)
+        scroll.setWidgetResizable(True)
+        content = QWidget(scroll)
+        scroll.setWidget(content)
+        panel_layout = QVBoxLayout(self)
+        panel_layout.setContentsMargins(0, 0, 0, 0)
+        panel_layout.addWidget(scroll)
+        outer = QVBoxLayout(content)
         top = QHBoxLayout()
         self.asset = QComboBox(self)
         self.asset.setObjectName("clothAsset")
@@ -93,7 +104,8 @@ class ClothPanel(QWidget):
         top.addWidget(self.asset, 1)
         top.addWidget(add)
         outer.addLayout(top)
-        sim = QHBoxLayout()
+        # Two short rows, not one long one: the dock can be narrow (issue 30, a laptop screen).
+        sim = QGridLayout()
         self.live = QCheckBox("Interactive", self)
         self.live.setObjectName("clothLive")
         self.live.setToolTip("Simulate in real time in the 3D view: W/A/S/D/Q/E move the pins, Z/C turn them, "
@@ -107,8 +119,9 @@ class ClothPanel(QWidget):
         self.reset.setObjectName("clothReset")
         self.reset.setToolTip("Put the interactive cloth back in its rest shape (Shift+R in the 3D view)")
         self.reset.clicked.connect(self._on_reset)
-        for w in (self.live, self.pause, self.reset):
-            sim.addWidget(w)
+        sim.addWidget(self.live, 0, 0, 1, 2)
+        sim.addWidget(self.pause, 1, 0)
+        sim.addWidget(self.reset, 1, 1)
         outer.addLayout(sim)
         self.message = QLabel(self)
         self.message.setObjectName("clothMessage")
@@ -144,8 +157,9 @@ class ClothPanel(QWidget):
         self.progress.hide()
         self.cancel.hide()
 
-        body = QWidget(self)
+        body = QWidget(content)
         form_layout = QVBoxLayout(body)
+        form_layout.setContentsMargins(0, 0, 0, 0)
         for title, names in GROUPS:
             head = QLabel(f"<b>{title}</b>", body)
             form_layout.addWidget(head)
@@ -154,14 +168,11 @@ class ClothPanel(QWidget):
                 form.addRow(_label(name), self._make_editor(name, body))
             form_layout.addLayout(form)
         form_layout.addStretch(1)
-        scroll = QScrollArea(self)
-        scroll.setWidgetResizable(True)
-        scroll.setWidget(body)
-        outer.addWidget(scroll, 1)
+        wrap_long_rows(body)
+        outer.addWidget(body, 1)
         known = {f.name for f in fields(ClothParams)}
         missing = known - set(self.editors)
         assert not missing, f"cloth fields without an editor: {missing}"
-        scroll.setMinimumHeight(220)
         ctx.documentChanged.connect(self._on_changed)
         ctx.documentReset.connect(self.refresh_assets)
         vp = self._viewport()

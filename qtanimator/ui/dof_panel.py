@@ -16,7 +16,6 @@ from PySide6.QtGui import QKeyEvent
 from PySide6.QtWidgets import (
     QDoubleSpinBox,
     QGridLayout,
-    QHBoxLayout,
     QLabel,
     QPushButton,
     QSlider,
@@ -129,15 +128,17 @@ class DofPanel(QWidget):
         self.grid = QGridLayout(self.grid_host)
         self.grid.setContentsMargins(0, 0, 0, 0)
         layout.addWidget(self.grid_host)
-        buttons = QHBoxLayout()
+        # Previous / Next above Reset Pose: the outliner dock can be narrow (issue 30).
+        buttons = QGridLayout()
         self.prev_button = QPushButton("◀ Previous", self)
         self.prev_button.setObjectName("previousJointButton")
         self.next_button = QPushButton("Next ▶", self)
         self.next_button.setObjectName("nextJointButton")
         self.reset_button = QPushButton("Reset Pose (R)", self)
         self.reset_button.setObjectName("resetPoseButton")
-        for b in (self.prev_button, self.next_button, self.reset_button):
-            buttons.addWidget(b)
+        buttons.addWidget(self.prev_button, 0, 0)
+        buttons.addWidget(self.next_button, 0, 1)
+        buttons.addWidget(self.reset_button, 1, 0, 1, 2)
         layout.addLayout(buttons)
         layout.addStretch(1)
         self._editing = False

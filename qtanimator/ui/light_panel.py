@@ -12,9 +12,11 @@ from PySide6.QtGui import QColor
 from PySide6.QtWidgets import (
     QColorDialog,
     QFormLayout,
+    QFrame,
     QGroupBox,
     QHBoxLayout,
     QPushButton,
+    QScrollArea,
     QVBoxLayout,
     QWidget,
 )
@@ -25,9 +27,11 @@ from qtanimator.document.parameters import AMBIENT_PARAMETER, LIGHT_NAMES, LIGHT
 from qtanimator.render.gl.lights import parameter
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.param_fields import spin_for
-from qtanimator.ui.widgets import CheckedDoubleSpinBox
+from qtanimator.ui.widgets import CheckedDoubleSpinBox, wrap_long_rows
 
 _gestures = itertools.count(1)
+#: The narrowest a position field (x, y or z) may get, in pixels: three share a row.
+POSITION_MIN_WIDTH = 56
 # The fields' ranges, steps, decimals and labels come from the parameter schema
 # (qtanimator.document.parameters.LIGHTS): a light's intensity is any number ≥ 0 and its
 # position any place (the maximums are far beyond use). A typed value outside them is
@@ -71,9 +75,19 @@ class LightPanel(QWidget):
         self.color: dict[str, ColorButton] = {}
         self._updating = False
         self._gesture: tuple[str, int] | None = None
-        layout = QVBoxLayout(self)
+        outer = QVBoxLayout(self)
+        outer.setContentsMargins(0, 0, 0, 0)
+        # The groups scroll when the dock is short or narrow (a laptop screen, issue 30).
+        self.scroll_area = QScrollArea(self)
+        self.scroll_area.setObjectName("lightScroll")
+        self.scroll_area.setWidgetResizable(True)
+        self.scroll_area.setFrameShape(QFrame.Shape.NoFrame)
+        body = QWidget(self.scroll_area)
+        self.scroll_area.setWidget(body)
+        outer.addWidget(self.scroll_area)
+        layout = QVBoxLayout(body)
         for i, name in enumerate(LIGHT_NAMES, start=1):
-            box = QGroupBox(f"Light {i}", self)
+            box = QGroupBox(f"Light {i}", body)
             form = QFormLayout(box)
             position = LIGHTS[f"{name}.position"]
             row = QHBoxLayout()
@@ -81,6 +95,7 @@ class LightPanel(QWidget):
             for axis in "xyz":
                 s = spin_for(position, box, f"{name}_position_{axis}", f"{position.label} {axis}")
                 assert isinstance(s, CheckedDoubleSpinBox)
+                s.setMinimumWidth(POSITION_MIN_WIDTH)
                 s.valueChanged.connect(lambda _v, n=name: self._position_edited(n))
                 s.editingFinished.connect(self.end_gesture)
                 row.addWidget(s)
@@ -99,12 +114,13 @@ class LightPanel(QWidget):
             self.intensity[name] = inten
             form.addRow("Intensity", inten)
             layout.addWidget(box)
-        amb = QGroupBox("Ambient", self)
+        amb = QGroupBox("Ambient", body)
         form = QFormLayout(amb)
         self.color[AMBIENT_PARAMETER] = ColorButton(self, AMBIENT_PARAMETER)
         form.addRow("Colour", self.color[AMBIENT_PARAMETER])
         layout.addWidget(amb)
         layout.addStretch(1)
+        wrap_long_rows(body)
         ctx.documentChanged.connect(self._on_changed)
         ctx.documentReset.connect(self.refresh)
         self.refresh()

@@ -14,8 +14,17 @@ from collections.abc import Callable, Collection
 from pathlib import Path
 
 import shiboken6
-from PySide6.QtCore import QByteArray, Qt
-from PySide6.QtGui import QAction, QCloseEvent, QDragEnterEvent, QDropEvent, QIcon, QKeySequence
+from PySide6.QtCore import QByteArray, QRect, QSize, Qt
+from PySide6.QtGui import (
+    QAction,
+    QCloseEvent,
+    QDragEnterEvent,
+    QDropEvent,
+    QGuiApplication,
+    QIcon,
+    QKeySequence,
+    QShowEvent,
+)
 from PySide6.QtWidgets import (
     QApplication,
     QCheckBox,
@@ -34,9 +43,9 @@ from qtanimator.document.asset_files import ASSETS_FOLDER, file_refs, is_inside
 from qtanimator.document.document import Document
 from qtanimator.document.io import open_document_relinked, save_document
 from qtanimator.formats.errors import FormatError
-from qtanimator.paths import app_icon_path
+from qtanimator.paths import app_icon_path, is_sample
 from qtanimator.ui import errors, help_viewer
-from qtanimator.ui.app_settings import last_dir, settings
+from qtanimator.ui.app_settings import last_dir, save_dir, settings
 from qtanimator.ui.asset_collect import collect_into, locate_missing_file, tell_relinked
 from qtanimator.ui.context import EditorContext
 from qtanimator.ui.recent_files import RecentFiles
@@ -61,6 +70,24 @@ EDITOR_MODULES: list[str] = [
     "qtanimator.ui.export_dialog",
     "qtanimator.ui.recovery",
 ]
+
+#: The first run's window: this share of the screen's available area (each way), at most
+#: :data:`FIRST_RUN_MAX` logical pixels, centred. A layout restored from the settings is
+#: clamped to the available area instead (the screen may have changed since).
+FIRST_RUN_SHARE = 0.9
+FIRST_RUN_MAX = QSize(1600, 1000)
+#: On a smaller screen (available area, logical pixels) the first run opens maximised.
+SMALL_SCREEN = QSize(1600, 900)
+#: On a screen narrower than this (logical pixels: 1920 at scale 2 is 960) the first-run
+#: layout has one column of docks: the outliner is a tab beside Properties, Cloth and Lights.
+NARROW_SCREEN_WIDTH = 1200
+#: First-run dock sizes: the curve editor's share of the window height (at least
+#: :data:`CURVE_EDITOR_MIN_HEIGHT`), the timeline's height, the side columns' widths.
+CURVE_EDITOR_SHARE = 0.36
+CURVE_EDITOR_MIN_HEIGHT = 200
+TIMELINE_HEIGHT = 110
+OUTLINER_WIDTH = (260, 0.2)   # pixels, at most this share of the window width
+SIDE_DOCK_WIDTH = (380, 0.28)
 
 #: The view-state entry (``Document.view_state``) holding the current frame: saved with the
 #: project, restored on open, never an edit. (The play range is the project's
@@ -94,6 +121,9 @@ class MainWindow(QMainWindow):
         #: Asset files found at new places when the project was opened: the document differs
         #: from its file although the undo stack is clean (cleared by a save or another open).
         self._relinked_unsaved = False
+        #: The bundled sample this untitled document is a copy of (None otherwise): samples
+        #: open as untitled copies, so that Save asks where and never writes into them.
+        self.sample: Path | None = None
         self.openers: dict[str, Opener] = {}
         #: Called before the document is written (Save, Save As, autosave): editors put view
         #: state such as the 3D camera into the document here, without an undo step.
@@ -102,7 +132,9 @@ class MainWindow(QMainWindow):
         install_dock_behaviour()
         self.setAcceptDrops(True)
         self.setDockNestingEnabled(True)
-        self.resize(1400, 900)
+        #: True until the first show of a window whose layout came from no settings: the
+        #: dock sizes of the first-run layout are set then, when the window has its size.
+        self._first_run_docks = False
 
         self.central_tabs = QTabWidget(self)
         self.central_tabs.setObjectName("centralTabs")
@@ -118,7 +150,7 @@ class MainWindow(QMainWindow):
         # The undo stack is cleared while the window is destroyed: ignore that signal then.
         self.ctx.undo_stack.cleanChanged.connect(self._on_clean_changed)
         self.ctx.documentReset.connect(self._update_title)
-        self._default_layout()
+        self._default_layout(narrow=self.available_geometry().width() < NARROW_SCREEN_WIDTH)
         self._restore_layout()
         self._update_title()
 
@@ -256,6 +288,7 @@ class MainWindow(QMainWindow):
     def new_document(self) -> None:
         if self.maybe_save():
             self._relinked_unsaved = False
+            self.sample = None
             self.ctx.replace_document(Document())
 
     def replaces_document(self, path: str | os.PathLike[str]) -> bool:
@@ -305,9 +338,15 @@ class MainWindow(QMainWindow):
         return True
 
     def open_project(self, p: Path) -> None:
-        """Replace the document with the project ``p`` (FormatError / OSError: unchanged)."""
+        """Replace the document with the project ``p`` (FormatError / OSError: unchanged).
+
+        A bundled sample (:func:`qtanimator.paths.is_sample`) opens as an untitled copy: its
+        assets still come from the sample's folder, and Save asks where (as Save As)."""
         doc, relinks = open_document_relinked(p, lambda ref: locate_missing_file(self, ref))
         self._relinked_unsaved = bool(relinks)
+        self.sample = Path(doc.path) if doc.path and is_sample(doc.path) else None
+        if self.sample is not None:
+            doc.path = None
         self.ctx.replace_document(doc)
         self.restore_view_state()
         if relinks:
@@ -319,19 +358,29 @@ class MainWindow(QMainWindow):
         return self.save_to(self.doc.path)
 
     def save_as(self) -> bool:
-        """Ask where (and whether to collect the assets there), then save."""
-        start = self.doc.path or str(Path(last_dir()) / f"untitled{PROJECT_SUFFIX}")
-        path, collect = self.ask_save_path(start)
+        """Ask where (and whether to collect the assets there), then save.
+
+        The dialog starts beside the project, or for an untitled one in the last folder (the
+        documents folder when that is a samples folder). A copy of a sample is offered with
+        "Collect assets" ticked, so that the saved project does not depend on the
+        installation's files (the user's own choice of the box is not changed by that)."""
+        if self.doc.path:
+            start = self.doc.path
+        else:
+            name = self.sample.stem if self.sample is not None else "untitled"
+            start = str(Path(save_dir()) / f"{name}{PROJECT_SUFFIX}")
+        path, collect = self.ask_save_path(start) if self.sample is None else self.ask_save_path(start, collect=True)
         if not path:
             return False
         if not Path(path).suffix:
             path += PROJECT_SUFFIX
-        settings().setValue("collectAssets", collect)
+        if self.sample is None:
+            settings().setValue("collectAssets", collect)
         return self.save_to(path, collect=collect)
 
-    def ask_save_path(self, start: str) -> tuple[str, bool]:
+    def ask_save_path(self, start: str, collect: bool | None = None) -> tuple[str, bool]:
         """The Save As dialog: a path ("" when cancelled) and the state of its "Copy the
-        assets into the project folder" box (remembered from the last Save As)."""
+        assets into the project folder" box (``collect``, or when None as at the last Save As)."""
         dialog = QFileDialog(self, "Save Project", start, PROJECT_FILTER)
         dialog.setObjectName("saveAsDialog")
         dialog.setAcceptMode(QFileDialog.AcceptMode.AcceptSave)
@@ -341,7 +390,7 @@ class MainWindow(QMainWindow):
         box = QCheckBox(f"Collect assets: copy every file the project uses into its {ASSETS_FOLDER}/ folder")
         box.setObjectName("collectAssetsCheck")
         box.setToolTip("The project folder then holds everything: it can be moved, zipped or shared.")
-        box.setChecked(bool(settings().value("collectAssets", False, type=bool)))
+        box.setChecked(bool(settings().value("collectAssets", False, type=bool)) if collect is None else collect)
         layout = dialog.layout()
         if layout is not None:
             layout.addWidget(box)
@@ -369,8 +418,15 @@ class MainWindow(QMainWindow):
     def save_to(self, path: str | os.PathLike[str], collect: bool = False) -> bool:
         """Save to ``path``, making its folder when it does not exist; with ``collect``, copy
         the assets into that folder first (one undo step, Collect Assets). A failure shows
-        a sentence naming ``path`` and leaves the document as it was."""
+        a sentence naming ``path`` and leaves the document as it was.
+
+        Nothing is ever written into the bundled samples (they are part of the installation,
+        and a later update would replace them): such a target is refused with a sentence."""
         target = Path(path).absolute()
+        if is_sample(target):
+            self.show_error("Cannot save", f"{target} is in the samples that come with qtanimator, which are "
+                            "never overwritten. Save your copy in another folder.")
+            return False
         try:
             target.parent.mkdir(parents=True, exist_ok=True)
         except OSError as exc:
@@ -391,6 +447,7 @@ class MainWindow(QMainWindow):
             return False
         self.ctx.undo_stack.setClean()
         self._relinked_unsaved = False
+        self.sample = None
         self.recent.remember(target)
         self._update_title()
         return True
@@ -401,7 +458,8 @@ class MainWindow(QMainWindow):
         ``assets/`` and point the project at the copies (one undo step). An untitled
         project is saved first (Save As, with collecting ticked)."""
         if self.doc.path is None:
-            path, _collect = self.ask_save_path(str(Path(last_dir()) / f"untitled{PROJECT_SUFFIX}"))
+            name = self.sample.stem if self.sample is not None else "untitled"
+            path, _collect = self.ask_save_path(str(Path(save_dir()) / f"{name}{PROJECT_SUFFIX}"))
             if not path:
                 return False
             if not Path(path).suffix:
@@ -422,7 +480,12 @@ class MainWindow(QMainWindow):
             self._update_title()
 
     def _update_title(self) -> None:
-        name = Path(self.doc.path).name if self.doc.path else "untitled"
+        if self.doc.path:
+            name = Path(self.doc.path).name
+        elif self.sample is not None:
+            name = f"{self.sample.stem} (sample) — untitled"
+        else:
+            name = "untitled"
         self.setWindowTitle(f"{name}[*] — qtanimator")
         self.setWindowModified(self.is_modified())
 
@@ -438,9 +501,60 @@ class MainWindow(QMainWindow):
             event.acceptProposedAction()
 
     # --------------------------------------------------------------- layout
-    def _default_layout(self) -> None:
+    def available_geometry(self) -> QRect:
+        """The available area (without panels and docks of the desktop) of the window's
+        screen, in logical pixels."""
+        screen = self.screen() or QGuiApplication.primaryScreen()
+        return screen.availableGeometry() if screen is not None else QRect(0, 0, 1366, 768)
+
+    def _update_minimum_size(self) -> None:
+        """Let the layout set the window's minimum size for the docks as they are now (it
+        keeps the one of an earlier arrangement until it is next activated)."""
+        layout = self.layout()
+        if layout is not None:
+            layout.activate()
+
+    def fit_to_screen(self) -> None:
+        """The first run's geometry: :data:`FIRST_RUN_SHARE` of the available area, at
+        most :data:`FIRST_RUN_MAX`, never below the window's minimum where that fits, centred;
+        maximised on a screen smaller than :data:`SMALL_SCREEN`."""
+        self._update_minimum_size()
+        area = self.available_geometry()
+        minimum = self.minimumSizeHint()
+        width = min(max(round(area.width() * FIRST_RUN_SHARE), minimum.width()), FIRST_RUN_MAX.width(), area.width())
+        height = min(max(round(area.height() * FIRST_RUN_SHARE), minimum.height()), FIRST_RUN_MAX.height(),
+                     area.height())
+        self.resize(width, height)
+        self.move(area.x() + (area.width() - width) // 2, area.y() + (area.height() - height) // 2)
+        if area.width() < SMALL_SCREEN.width() or area.height() < SMALL_SCREEN.height():
+            # A laptop: every pixel counts, as in Blender and Krita (the size above is what
+            # "restore" gives, and what a window system that does not maximise shows).
+            self.setWindowState(self.windowState() | Qt.WindowState.WindowMaximized)
+
+    def clamp_to_screen(self) -> None:
+        """Make the window (its frame, when the window system has given it one) lie inside
+        the available area of its screen: smaller first, then moved."""
+        if self.isMaximized() or self.isFullScreen():
+            return
+        self._update_minimum_size()
+        area = self.available_geometry()
+        frame, inner = self.frameGeometry(), self.geometry()
+        extra_w, extra_h = max(frame.width() - inner.width(), 0), max(frame.height() - inner.height(), 0)
+        width = min(inner.width(), area.width() - extra_w)
+        height = min(inner.height(), area.height() - extra_h)
+        if (width, height) != (inner.width(), inner.height()):
+            self.resize(width, height)
+        frame = self.frameGeometry()
+        x = min(max(frame.x(), area.x()), area.right() + 1 - frame.width())
+        y = min(max(frame.y(), area.y()), area.bottom() + 1 - frame.height())
+        if (x, y) != (frame.x(), frame.y()):
+            self.move(x, y)
+
+    def _default_layout(self, narrow: bool = False) -> None:
         """First-run arrangement: curve editor (the dope sheet as a tab beside it) above the
-        timeline along the bottom, the joint tree on the left, properties / cloth / lights as tabs on the right."""
+        timeline along the bottom, the joint tree on the left, properties / cloth / lights as
+        tabs on the right. ``narrow`` (a small screen): the joint tree is a tab on the right
+        too, so that the window's minimum width fits."""
         def dock(name: str) -> QDockWidget | None:
             return self.findChild(QDockWidget, name)
 
@@ -449,29 +563,58 @@ class MainWindow(QMainWindow):
             self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, curve)
             self.addDockWidget(Qt.DockWidgetArea.BottomDockWidgetArea, timeline)
             self.splitDockWidget(curve, timeline, Qt.Orientation.Vertical)
-            self.resizeDocks([curve, timeline], [300, 130], Qt.Orientation.Vertical)
             dope = dock("dopeSheetDock")
             if dope is not None:  # both show keys: a tab beside the curve editor
                 self.tabifyDockWidget(curve, dope)
                 curve.raise_()
         right = [d for d in (dock("propertiesDock"), dock("clothDock"), dock("lightDock")) if d is not None]
+        tree = dock("jointTreeDock")
+        if narrow and tree is not None and right:
+            self.addDockWidget(Qt.DockWidgetArea.RightDockWidgetArea, tree)
+            right.insert(0, tree)
         for other in right[1:]:
             self.tabifyDockWidget(right[0], other)
         if right:
             right[0].raise_()
-            self.resizeDocks([right[0]], [380], Qt.Orientation.Horizontal)
-        tree = dock("jointTreeDock")
-        if tree is not None:
-            self.resizeDocks([tree], [260], Qt.Orientation.Horizontal)
+        self._first_run_docks = True
+
+    def _size_first_run_docks(self) -> None:
+        """The first-run dock sizes for the window's size: the curve editor gets a usable
+        height (:data:`CURVE_EDITOR_SHARE`), the side columns a share of the width."""
+        def dock(name: str) -> QDockWidget | None:
+            found = self.findChild(QDockWidget, name)
+            return found if found is not None and not found.isFloating() and found.isVisible() else None
+
+        size = self.size()
+        curve, timeline = dock("curveEditorDock"), dock("timelineDock")
+        if curve is not None and timeline is not None:
+            curve_height = max(round(size.height() * CURVE_EDITOR_SHARE), CURVE_EDITOR_MIN_HEIGHT)
+            self.resizeDocks([curve, timeline], [curve_height, TIMELINE_HEIGHT], Qt.Orientation.Vertical)
+        for name, (pixels, share) in (("propertiesDock", SIDE_DOCK_WIDTH), ("jointTreeDock", OUTLINER_WIDTH)):
+            side = dock(name)
+            if side is not None:
+                self.resizeDocks([side], [min(pixels, round(size.width() * share))], Qt.Orientation.Horizontal)
 
     def _restore_layout(self) -> None:
+        """The window and dock layout of the last session (clamped to the screen), or the
+        first-run size (:meth:`fit_to_screen`)."""
         s = settings()
         geometry = s.value("window/geometry")
         state = s.value("window/state")
-        if isinstance(geometry, QByteArray):
-            self.restoreGeometry(geometry)
-        if isinstance(state, QByteArray):
-            self.restoreState(state)
+        if isinstance(geometry, QByteArray) and self.restoreGeometry(geometry):
+            self.clamp_to_screen()
+        else:
+            self.fit_to_screen()
+        if isinstance(state, QByteArray) and self.restoreState(state):
+            self._first_run_docks = False
+
+    def showEvent(self, event: QShowEvent) -> None:
+        super().showEvent(event)
+        if not event.spontaneous():
+            self.clamp_to_screen()
+        if self._first_run_docks:
+            self._first_run_docks = False
+            self._size_first_run_docks()
 
     def closeEvent(self, event: QCloseEvent) -> None:
         if not self.maybe_save():

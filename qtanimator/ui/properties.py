@@ -29,6 +29,7 @@ from qtanimator.ui.properties_joint import JOINT_MODE_LABELS, LIMIT_RANGE_DEGREE
 from qtanimator.ui.properties_joint3d import joint3d_group
 from qtanimator.ui.properties_placement import placement_group
 from qtanimator.ui.properties_sim import ik_group, pendulum_group, spring_group
+from qtanimator.ui.widgets import wrap_long_rows
 
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
@@ -108,6 +109,7 @@ class PropertiesPanel(QWidget):
             layout.addWidget(label)
         layout.addWidget(ik_group(panel))
         layout.addStretch(1)
+        wrap_long_rows(body)
         self.scroll_area.setWidget(body)  # deletes the previous body
         self.body = body
         self.refresh()

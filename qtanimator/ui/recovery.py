@@ -3,7 +3,10 @@
 Every minute while the document has unsaved changes, the window writes it as an ordinary
 project into the recovery folder (``<settings>/recovery``, under QTANIMATOR_SETTINGS_DIR
 when set), next to a small ``.json`` note with the process id and the project's own path.
-Saving, closing or discarding removes both. At start, recovery files whose process is no
+Saving, closing or discarding removes both. An untitled copy of a bundled sample notes the
+sample (``"sample"``) and recovers as such a copy again; a note whose original path is in
+the samples recovers as an untitled copy too, so that recovery never leads to a write into
+the samples folder. At start, recovery files whose process is no
 longer running were left by a crash, and the user is asked whether to recover them.
 
 The UI thread only takes a snapshot of the document (a copy of a few dicts); a worker
@@ -29,6 +32,7 @@ from PySide6.QtWidgets import QApplication, QMessageBox
 from qtanimator.document.background_save import BackgroundSaver, SaveJob, same_snapshot
 from qtanimator.document.io import open_document, to_project_data
 from qtanimator.formats.errors import FormatError
+from qtanimator.paths import is_sample
 
 if TYPE_CHECKING:
     from qtanimator.ui.main_window import MainWindow
@@ -75,6 +79,8 @@ class RecoveryRecord:
     pid: int
     original_path: str | None
     saved_at: float
+    #: The bundled sample the autosaved document was an untitled copy of.
+    sample: str | None = None
 
     @property
     def orphaned(self) -> bool:
@@ -92,8 +98,10 @@ def list_recovery_files() -> list[RecoveryRecord]:
         project = note.with_suffix(SUFFIX)
         try:
             meta = json.loads(note.read_text(encoding="utf-8"))
+            sample = meta.get("sample")
             records.append(RecoveryRecord(project, note, int(meta.get("pid", 0)),
-                                          meta.get("original_path"), float(meta.get("saved_at", 0.0))))
+                                          meta.get("original_path"), float(meta.get("saved_at", 0.0)),
+                                          sample if isinstance(sample, str) else None))
         except (OSError, ValueError, TypeError, AttributeError):
             continue
     records.sort(key=lambda r: -r.saved_at)
@@ -193,8 +201,9 @@ class RecoveryManager(QObject):
             latest = self._written
         if latest is not None and same_snapshot(latest.data, data) and latest.context == doc.path:
             return False  # being written, or on disk already
+        sample = self.window.sample
         note = {"pid": os.getpid(), "original_path": doc.path, "saved_at": time.time(),
-                "qtanimator_recovery": 1}
+                "qtanimator_recovery": 1, "sample": str(sample) if sample is not None else None}
         job = self.saver.submit(data, self.project_path,
                                 [(self.note_path, json.dumps(note, indent=1).encode("utf-8"))],
                                 context=doc.path)
@@ -248,7 +257,11 @@ class RecoveryManager(QObject):
         except (FormatError, OSError) as exc:
             self.window.show_error("Cannot recover", str(exc))
             return False
-        doc.path = record.original_path
+        sample = record.sample
+        if record.original_path and is_sample(record.original_path):
+            sample = record.original_path  # written before samples opened as copies
+        doc.path = None if sample else record.original_path
+        self.window.sample = Path(sample) if sample else None
         self.window.ctx.replace_document(doc)
         self.window.restore_view_state()
         # The recovered work is not saved anywhere the user chose: keep it marked modified.
@@ -262,7 +275,12 @@ class RecoveryManager(QObject):
         """Ask about each crashed session's file (newest first). True if one was recovered."""
         for record in crashed_sessions():
             when = time.strftime("%Y-%m-%d %H:%M", time.localtime(record.saved_at))
-            name = Path(record.original_path).name if record.original_path else "an untitled project"
+            if record.original_path:
+                name = Path(record.original_path).name
+            elif record.sample:
+                name = f"an untitled copy of the sample {Path(record.sample).stem}"
+            else:
+                name = "an untitled project"
             answer = QMessageBox.question(
                 self.window, "Recover unsaved work",
                 f"qtanimator did not close properly. Recover the changes to {name} autosaved at {when}?",

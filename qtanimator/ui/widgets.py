@@ -34,6 +34,7 @@ from PySide6.QtWidgets import (
     QApplication,
     QComboBox,
     QDoubleSpinBox,
+    QFormLayout,
     QLineEdit,
     QMainWindow,
     QScrollBar,
@@ -149,6 +150,14 @@ def install_dock_behaviour(app: QApplication | None = None) -> DockBehaviour | N
     behaviour.setObjectName("qtanimatorDockBehaviour")
     app.installEventFilter(behaviour)
     return behaviour
+
+
+def wrap_long_rows(widget: QWidget) -> None:
+    """Let every form under ``widget`` put a field below its label when the row does not
+    fit (QFormLayout.WrapLongRows): a dock's form then needs the width of its widest label
+    or field, not of both side by side, and the dock can be narrow (a laptop screen)."""
+    for form in widget.findChildren(QFormLayout):
+        form.setRowWrapPolicy(QFormLayout.RowWrapPolicy.WrapLongRows)
 
 
 # --------------------------------------------------------------- checked fields

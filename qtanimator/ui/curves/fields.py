@@ -12,7 +12,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
-from PySide6.QtWidgets import QHBoxLayout, QLabel, QWidget
+from PySide6.QtWidgets import QHBoxLayout, QLabel, QSizePolicy, QWidget
 
 from qtanimator.core.channel import Tangent
 from qtanimator.document.commands import EditKey
@@ -20,6 +20,10 @@ from qtanimator.document.curve_commands import SetKeySlopes
 from qtanimator.ui.curves.normalisation import unit_suffix
 from qtanimator.ui.curves.view import CurveView
 from qtanimator.ui.widgets import CheckedDoubleSpinBox
+
+#: The narrowest a key field may get, in pixels: the row shares the curve editor's width with
+#: the channel tree (a 1366-pixel laptop screen, issue 30); a long value scrolls in its field.
+KEY_FIELD_MIN_WIDTH = 64
 
 
 def _spin(name: str, decimals: int, tip: str) -> CheckedDoubleSpinBox:
@@ -29,7 +33,7 @@ def _spin(name: str, decimals: int, tip: str) -> CheckedDoubleSpinBox:
     box.setDecimals(decimals)
     box.setKeyboardTracking(False)   # one command on Enter / focus out / arrow step
     box.setToolTip(tip)
-    box.setMinimumWidth(90)
+    box.setMinimumWidth(KEY_FIELD_MIN_WIDTH)
     return box
 
 
@@ -55,6 +59,9 @@ class KeyFields(QWidget):
             self.tcb[name] = box
         self.label = QLabel("No key selected")
         self.label.setObjectName("curveKeyLabel")
+        # The channel name takes what room is left, and none when there is none (its full
+        # text is the tooltip): it never makes the curve editor wider.
+        self.label.setSizePolicy(QSizePolicy.Policy.Ignored, QSizePolicy.Policy.Preferred)
         layout = QHBoxLayout(self)
         layout.setContentsMargins(4, 2, 4, 2)
         layout.addWidget(self.label, 1)
@@ -100,6 +107,7 @@ class KeyFields(QWidget):
         if found is None:
             self._show_tcb(None)
             self.label.setText("No key selected")
+            self.label.setToolTip("")
             for box in boxes:
                 box.clear()  # empty: nothing to show (the value is kept, unused)
             return
@@ -109,6 +117,7 @@ class KeyFields(QWidget):
         s_in, s_out = ch.slopes()
         count = sum(len(s) for s in self.view.selection.values())
         self.label.setText(f"{cid} [{i}]" + (f" (+{count - 1})" if count > 1 else ""))
+        self.label.setToolTip(self.label.text())
         unit, suffix = self.unit(cid), unit_suffix(cid)
         self._loading = True
         try:
