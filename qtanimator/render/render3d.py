@@ -21,15 +21,12 @@ from PySide6.QtOpenGL import QOpenGLFramebufferObject, QOpenGLFramebufferObjectF
 
 from qtanimator.render.gl import surface_format
 from qtanimator.render.gl.camera import OrbitCamera
+from qtanimator.render.gl.capability import GLUnavailableError, context_problem
 from qtanimator.render.gl.lights import ambient_of, lights_of
 from qtanimator.render.gl.renderer import SceneItem, SceneRenderer, ViewOptions, grid_scale_for
 from qtanimator.render.painter2d import image_to_array
 from qtanimator.render.scene3d import scene_bounds, scene_items
 from qtanimator.render.xvfb import start_private_xvfb
-
-
-class GLUnavailableError(OSError):
-    """No OpenGL 3.3 context can be made here; the message says why."""
 
 
 def ensure_gui_application() -> QGuiApplication:
@@ -60,9 +57,10 @@ class OffscreenGL:
                 f"cannot create an OpenGL context on the '{QGuiApplication.platformName()}' platform "
                 "(3D rendering needs a display or Xvfb; qtanimator.render.render3d.ensure_gui_application() "
                 "starts a private Xvfb when it creates the application)")
+        problem = context_problem(self.context)
+        if problem:
+            raise GLUnavailableError(problem)
         fmt = self.context.format()
-        if (fmt.majorVersion(), fmt.minorVersion()) < (3, 3):
-            raise GLUnavailableError(f"OpenGL {fmt.majorVersion()}.{fmt.minorVersion()} < 3.3")
         self.surface = QOffscreenSurface()
         self.surface.setFormat(fmt)
         self.surface.create()

@@ -36,6 +36,7 @@ from qtanimator.ui.dof_specs import (
     joint_names,
     reset_pose_command,
 )
+from qtanimator.ui.key_routing import install_view_key_router
 from qtanimator.ui.outliner_tree import (
     EYE_COLUMN,
     KIND_ROLE,
@@ -102,6 +103,8 @@ class JointTreePanel(QWidget):
 
 
 def install(window: MainWindow) -> None:
+    # A letter typed in the tree while the pointer is over a view is that view's key.
+    install_view_key_router()
     panel = JointTreePanel(window.ctx)
     window.joint_tree = panel  # type: ignore[attr-defined]
     window.add_dock("jointTreeDock", "Outliner", panel, Qt.DockWidgetArea.LeftDockWidgetArea)

@@ -3,8 +3,9 @@ skeleton with its joints, the other assets and the two lights.
 
 The tree follows ``ctx.selection`` and sets it; keyframed joints carry a key icon (filled
 once the joint has keys), dynamic (pendulum) joints a white bob. Each row has an eye and a
-lock; F2 renames an asset, Delete removes it, the right-click menu frames, resets, hides,
-locks, renames or removes it. Drag a 2D joint onto another joint of the same character to
+lock; F2 renames an asset, Delete removes it, F frames the current row's asset in its view
+(there is no type-ahead: letters never move the current row), the right-click menu frames,
+resets, hides, locks, renames or removes it. Drag a 2D joint onto another joint of the same character to
 re-parent it (one undo step, :func:`qtanimator.document.rigging.reparent_command`); a drop
 that would make a joint hang from itself is refused with a message in the status bar.
 """
@@ -167,9 +168,20 @@ class JointTree(QTreeWidget):
             return True
         return super().event(event)
 
+    def keyboardSearch(self, search: str) -> None:
+        """No type-ahead: a letter typed here is a view's key (F frames), never a jump to the
+        next row whose name starts with it (see :mod:`qtanimator.ui.key_routing`)."""
+
     def keyPressEvent(self, event: QKeyEvent) -> None:
         item = self.currentItem()
         if self.state() != self.State.EditingState and event.modifiers() == Qt.KeyboardModifier.NoModifier:
+            if event.key() == Qt.Key.Key_F:
+                # Frame the current row's asset in its view (the pointer was not over a
+                # view: then the view has the key, see key_routing).
+                if item is not None and self.row_kind(item) != "light":
+                    self.frame_in_view(item.data(0, ROLE)[0])
+                event.accept()
+                return
             if event.key() == Qt.Key.Key_F2 and item is not None:
                 self.start_rename(item)
                 event.accept()

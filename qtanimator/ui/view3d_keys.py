@@ -5,6 +5,7 @@ skeleton (its ``s``); S / I key the selected joint (Shift+S its whole character)
 Ctrl+V (Ctrl+Shift+V mirrored) copy and paste a pose, R resets the selected character's
 pose; W/A/S/D/Q/E and Z/C move a live cloth's pins, P pauses it, Shift+R resets it; Escape
 cancels an IK, light or placement drag. The view sees these keys from the GL surface too.
+Letters with Ctrl, Alt or Meta do nothing here unless bound above (Ctrl+A moves no pin).
 """
 
 from __future__ import annotations
@@ -84,6 +85,9 @@ class ViewKeys(ViewDrags):
             self.set_display(show_skeleton=True)
 
     def keyPressEvent(self, event: QKeyEvent) -> None:
+        """The view's keys. Letters act only without Ctrl, Alt and Meta (Shift is part of some
+        keys: Shift+S, Shift+R); a Ctrl / Alt / Meta combination that is not bound here
+        (Ctrl+A, Ctrl+D, Alt+W …) does nothing and goes on to the parent as unhandled."""
         key = event.key()
         mods = event.modifiers() & ~Qt.KeyboardModifier.KeypadModifier
         ctrl, shift = Qt.KeyboardModifier.ControlModifier, Qt.KeyboardModifier.ShiftModifier
@@ -96,7 +100,7 @@ class ViewKeys(ViewDrags):
             self.copy_pose()
         elif key == Qt.Key.Key_V and mods in (ctrl, ctrl | shift):
             self.paste_pose(mirrored=bool(mods & shift))
-        elif key == Qt.Key.Key_F:
+        elif key == Qt.Key.Key_F and plain:
             self.frame_selection()
         elif key == Qt.Key.Key_X and mods == Qt.KeyboardModifier.NoModifier:
             # the MIT viewer's ``a`` (A moves the cloth pins here)
@@ -104,9 +108,9 @@ class ViewKeys(ViewDrags):
         elif key == Qt.Key.Key_B and mods == Qt.KeyboardModifier.NoModifier:
             # the MIT viewer's ``s`` (S sets a key here)
             self.toggle_skeleton()
-        elif key in PIN_KEYS or key in PIN_TURNS:
+        elif (key in PIN_KEYS or key in PIN_TURNS) and plain:
             self.pin_key(key)
-        elif key == Qt.Key.Key_P:
+        elif key == Qt.Key.Key_P and plain:
             self.live.paused = not self.live.paused
         elif key == Qt.Key.Key_R and mods == shift:
             self.reset_cloth()

@@ -67,6 +67,7 @@ from qtanimator.render.scene3d import joint_index
 from qtanimator.ui.camera_fields import show_camera_dialog
 from qtanimator.ui.clip_controls import ClipControls
 from qtanimator.ui.context import EditorContext
+from qtanimator.ui.key_routing import install_view_key_router
 from qtanimator.ui.view3d import Viewport3D, grab_with_3d
 from qtanimator.ui.view3d_camera import CAMERA_PARAMETER
 from qtanimator.ui.view3d_cloth import PIN_KEYS, PIN_STEP, PIN_TURN, PIN_TURNS, SIM_DT
@@ -220,6 +221,8 @@ class _PrepareOnShow(QObject):
 
 
 def install(window: Any) -> None:
+    # A letter typed in a tree while the pointer is over the 3D view is the view's key.
+    install_view_key_router()
     panel = ViewportPanel(window.ctx, window, window)
     _PrepareOnShow(window, panel.view)
     window.viewport_panel = panel

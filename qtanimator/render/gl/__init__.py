@@ -16,8 +16,6 @@ SOFTWARE_RENDERERS = ("llvmpipe", "softpipe", "swrast", "software rasterizer", "
 #: Samples of the interactive 3D view on a GPU.
 VIEW_SAMPLES = 4
 
-_probed: list[str] = []
-
 
 def surface_format(samples: int = 4) -> QSurfaceFormat:
     """The format every 3D context uses: OpenGL 3.3 core, 24-bit depth, multisampling."""
@@ -32,30 +30,11 @@ def surface_format(samples: int = 4) -> QSurfaceFormat:
 
 
 def gl_renderer_name() -> str:
-    """GL_RENDERER of a default context here ("" when none can be made): asked once per
-    process with a throw-away offscreen context (about 40 ms on llvmpipe)."""
-    if not _probed:
-        name = ""
-        try:
-            from PySide6.QtGui import QGuiApplication, QOffscreenSurface, QOpenGLContext
+    """GL_RENDERER of a default context here ("" when none can be made): the one probe of
+    :func:`qtanimator.render.gl.capability.probe_gl`, asked once per process."""
+    from qtanimator.render.gl.capability import probe_gl
 
-            if QGuiApplication.instance() is not None:
-                context = QOpenGLContext()
-                context.setFormat(surface_format(0))
-                surface = QOffscreenSurface()
-                surface.setFormat(context.format())
-                surface.create()
-                if context.create() and context.makeCurrent(surface):
-                    from OpenGL import GL
-
-                    raw = GL.glGetString(GL.GL_RENDERER)
-                    name = raw.decode(errors="replace") if isinstance(raw, bytes) else str(raw or "")
-                    context.doneCurrent()
-                surface.destroy()
-        except Exception:  # noqa: BLE001 - no GL here: the view reports it when it shows
-            name = ""
-        _probed.append(name)
-    return _probed[0]
+    return probe_gl().renderer
 
 
 def is_software_renderer(name: str) -> bool:
