@@ -46,7 +46,7 @@ install_system_packages() {
 }
 
 setup_venv() {
-  # Extras: test (pytest, linters) and fast (numba: the compiled cloth kernels; CI also runs
+  # Extras: test (pytest, linters). numba (the compiled cloth kernels) is a dependency; CI also runs
   # the cloth tests without it, QTANIMATOR_NO_NUMBA=1). Exact versions come from
   # constraints.txt; pyproject.toml holds the ranges a user's pip may choose from.
   local extras="$1"
@@ -87,18 +87,18 @@ shift || true
 case "$cmd" in
   run)
     install_system_packages
-    setup_venv test,fast
+    setup_venv test
     exec .venv/bin/qtanimator "$@"
     ;;
   test)
     install_system_packages
-    setup_venv test,fast
+    setup_venv test
     setup_gltf_validator
     exec .venv/bin/python -m pytest "$@"
     ;;
   bench)
     install_system_packages
-    setup_venv "test,fast,bench"
+    setup_venv "test,bench"
     exec .venv/bin/python -m benchmarks "$@"
     ;;
   *)

@@ -8,13 +8,18 @@ that folder; the GUI's exception hook writes every unexpected error there.
 
 from __future__ import annotations
 
+import faulthandler
 import logging
 import logging.handlers
 import os
 import sys
 from pathlib import Path
+from typing import TextIO
 
 LOG_NAME = "qtanimator.log"
+#: Native crash traces of the GUI (faulthandler: a segfault or an abort in Qt, OpenGL or the
+#: interpreter leaves the Python stack of every thread here; issue 30).
+CRASH_LOG_NAME = "crash.log"
 MAX_BYTES = 1_000_000
 BACKUPS = 3
 FORMAT = "%(asctime)s %(levelname)s %(name)s: %(message)s"
@@ -69,6 +74,38 @@ def setup_logging(verbose: bool = False) -> Path | None:
 def _add(root: logging.Logger, handler: logging.Handler) -> None:
     root.addHandler(handler)
     _handlers.append(handler)
+
+
+def enable_crash_traces(to_log_folder: bool) -> Path | None:
+    """Make a native crash (SIGSEGV, SIGABRT, SIGFPE, SIGBUS, SIGILL) print the Python stack of
+    every thread before the process dies. On stderr by default (a terminal, CI's log); with
+    ``to_log_folder`` (the GUI, often started without a terminal) appended to
+    :data:`CRASH_LOG_NAME` beside the log file, which Help ▸ Report a Problem opens. Returns
+    that file, or None when the traces go to stderr."""
+    if to_log_folder:
+        path = log_dir() / CRASH_LOG_NAME
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            # Kept open for the life of the process: faulthandler writes to its descriptor
+            # from the signal handler, where nothing can be opened.
+            stream = open(path, "a", encoding="utf-8")
+        except OSError as exc:
+            logging.getLogger(__name__).warning("no crash log (%s): %s", path, exc.strerror or exc)
+        else:
+            global _crash_stream
+            if _crash_stream is not None:
+                _crash_stream.close()
+            _crash_stream = stream
+            faulthandler.enable(file=stream, all_threads=True)
+            return path
+    try:
+        faulthandler.enable(file=sys.stderr, all_threads=True)
+    except (AttributeError, ValueError, OSError):
+        pass  # no stderr, or one without a file descriptor (captured by a test runner)
+    return None
+
+
+_crash_stream: TextIO | None = None
 
 
 def close_logging() -> None:

@@ -47,6 +47,9 @@ class OneLineParser(argparse.ArgumentParser):
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status (``--help`` and usage errors too)."""
     args = list(sys.argv[1:] if argv is None else argv)
+    # A native crash (Qt, OpenGL, the interpreter) leaves its stack on stderr; the GUI moves it
+    # into the log folder once it starts (_gui).
+    applog.enable_crash_traces(to_log_folder=False)
     try:
         if args and args[0] == "info":
             return _info(args[1:])
@@ -138,7 +141,9 @@ def _gui(args: list[str]) -> int:
 
     log_file = applog.setup_logging(ns.verbose)
     log = logging.getLogger("qtanimator")
-    log.info("qtanimator %s starting (Python %s), log %s", __version__, sys.version.split()[0], log_file)
+    crash_log = applog.enable_crash_traces(to_log_folder=True)
+    log.info("qtanimator %s starting (Python %s), log %s, native crash traces in %s", __version__,
+             sys.version.split()[0], log_file, crash_log or "stderr")
 
     from PySide6.QtGui import QGuiApplication, QIcon
     from PySide6.QtWidgets import QApplication

@@ -101,12 +101,24 @@ def test_the_long_description_has_no_relative_image_links() -> None:
 
 
 # ------------------------------------------------------------------ dependencies
-def _requirements(items: list[str]) -> dict[str, str]:
+#: Releases known to crash the program, each with the Pythons it crashes on (issue 30): PySide6
+#: 6.12.0's shiboken drops a reference to None on every method that returns nothing, which
+#: aborts Python < 3.12 ("none_dealloc"; None is immortal from 3.12).
+KNOWN_CRASHES = {"pyside6-essentials": [("6.12.0", ("3.11",))], "shiboken6": [("6.12.0", ("3.11",))]}
+
+
+def _requirements(items: list[str], python: str = "3.11") -> dict[str, str]:
+    """name -> specifier of the requirements that apply on ``python`` (markers evaluated)."""
+    from packaging.requirements import Requirement
+
     out = {}
     for item in items:
-        m = re.fullmatch(r"([A-Za-z0-9_.-]+)\s*(.*)", item)
-        assert m, item
-        out[_norm(m.group(1))] = m.group(2)
+        req = Requirement(item)
+        if req.marker is None or req.marker.evaluate({"python_version": python, "python_full_version": python + ".0",
+                                                      "extra": ""}):
+            name = _norm(req.name)
+            assert name not in out, f"two requirements of {name} apply on Python {python}"
+            out[name] = str(req.specifier)
     return out
 
 
@@ -131,21 +143,42 @@ def test_install_metadata_has_ranges_and_the_constraints_pin_exactly() -> None:
     project = _pyproject()["project"]
     deps = _requirements(project["dependencies"])
     extras = project["optional-dependencies"]
-    assert "numba" not in deps and _requirements(extras["fast"]) == {"numba": ">=0.60"}
+    # numba is a dependency (issue 30: the compiled cloth is what a plain install must get).
+    assert deps.get("numba") == ">=0.60" and "fast" not in extras
     for name, spec in deps.items():
         assert "==" not in spec and ">=" in spec, f"{name}{spec}: a range with a lower bound, never a pin"
     pins = _pins(REPO / "constraints.txt")
     lower = _pins(REPO / "constraints-min.txt")
-    for name, spec in {**deps, **_requirements(extras["fast"]), **_requirements(extras["test"])}.items():
+    for name, spec in {**deps, **_requirements(extras["test"])}.items():
         assert name in pins, f"constraints.txt pins no version of {name}"
         assert pins[name] in SpecifierSet(spec), f"constraints.txt: {name}=={pins[name]} is outside {spec}"
-    for name, spec in {**deps, **_requirements(extras["fast"])}.items():
+    for name, spec in deps.items():
         bound = re.search(r">=([0-9.]+)", spec)
         assert bound and name in lower, f"constraints-min.txt has no {name}"
         assert lower[name] == bound.group(1) or lower[name].startswith(bound.group(1) + "."), (
             f"the tested lower bound of {name} is {lower[name]}, but pyproject.toml says {spec}")
+        assert lower[name] in SpecifierSet(spec), f"constraints-min.txt: {name}=={lower[name]} is outside {spec}"
     # ./dev.sh and CI install with the constraints.
     assert '-c constraints.txt' in (REPO / "dev.sh").read_text(encoding="utf-8")
+
+
+@pytest.mark.parametrize("python", ["3.11", "3.12", "3.13"])
+def test_install_metadata_excludes_the_releases_known_to_crash(python: str) -> None:
+    """pip must never pick a release that aborts the interpreter (issue 30: PySide6 6.12.0 on
+    Python 3.11 was what every `pip install qtanimator` got)."""
+    from packaging.specifiers import SpecifierSet
+
+    deps = _requirements(_pyproject()["project"]["dependencies"], python)
+    assert "pyside6-essentials" in deps
+    for name, crashes in KNOWN_CRASHES.items():
+        for version, pythons in crashes:
+            if python in pythons:
+                # shiboken6 comes in through PySide6-Essentials, which pins its own release exactly.
+                spec = deps.get(name, deps["pyside6-essentials"])
+                assert version not in SpecifierSet(spec), f"{name} {version} crashes on Python {python}: {spec}"
+    # Where it does not crash the release stays allowed (the exclusion is as narrow as the cause).
+    if python != "3.11":
+        assert "6.12.0" in SpecifierSet(deps["pyside6-essentials"])
 
 
 def _copy_sources(dest: Path) -> Path:
@@ -229,7 +262,8 @@ def test_wheel_contains_package_resources_and_scenes(tmp_path: Path) -> None:
     assert meta["Keywords"] and meta.get_all("Classifier")
     requires = meta.get_all("Requires-Dist") or []
     assert not [r for r in requires if "==" in r.split(";")[0]], requires
-    assert 'numba>=0.60; extra == "fast"' in requires
+    assert "numba>=0.60" in requires
+    assert 'PySide6-Essentials!=6.12.0,<7,>=6.8; python_version < "3.12"' in requires, requires
     body = meta.get_payload()
     assert meta["Description-Content-Type"] == "text/markdown"
     assert "## Quick start" in body and "![" not in body
@@ -327,9 +361,12 @@ def test_desktop_integration_installer_puts_the_files_in_place(tmp_path: Path) -
     bash = shutil.which("bash")
     if bash is None:
         pytest.skip("bash is not installed")
-    exe = "/opt/qt animator/qtanimator"
+    exe = tmp_path / "qt animator" / "qtanimator"
+    exe.parent.mkdir()
+    exe.write_text("#!/bin/sh\n", encoding="utf-8")
+    exe.chmod(0o755)
     proc = subprocess.run([bash, str(PACKAGING / "install-desktop-integration.sh"), "--prefix", str(tmp_path),
-                           "--exec", exe], capture_output=True, text=True, timeout=60)
+                           "--exec", str(exe)], capture_output=True, text=True, timeout=60)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     entry = tmp_path / "applications" / DESKTOP.name
     assert f'Exec="{exe}" %f' in entry.read_text(encoding="utf-8")
@@ -342,10 +379,58 @@ def test_desktop_integration_installer_puts_the_files_in_place(tmp_path: Path) -
         assert check.returncode == 0, check.stdout + check.stderr
 
 
-# ------------------------------------------------------------------ numba is optional
+def _fake_install(root: Path) -> Path:
+    """A venv-like bin folder: a `qtanimator` script whose shebang is this test's Python."""
+    bin_dir = root / "venv" / "bin"
+    bin_dir.mkdir(parents=True)
+    exe = bin_dir / "qtanimator"
+    exe.write_text(f"#!{sys.executable}\nimport sys\nfrom qtanimator.cli import main\nsys.exit(main())\n",
+                   encoding="utf-8")
+    exe.chmod(0o755)
+    return exe
+
+
+def test_desktop_integration_runs_the_absolute_path_of_the_qtanimator_on_path(tmp_path: Path) -> None:
+    """A venv or pipx install: the desktop session's PATH lacks its bin folder, so a bare
+    `Exec=qtanimator` would be hidden; the entry names the executable found now (issue 30)."""
+    import os
+
+    bash = shutil.which("bash")
+    if bash is None:
+        pytest.skip("bash is not installed")
+    exe = _fake_install(tmp_path)
+    prefix = tmp_path / "share"
+    env = {**os.environ, "PATH": f"{exe.parent}:/usr/bin:/bin"}
+    # Run from another folder, as a user would after `cd ~`.
+    proc = subprocess.run([bash, str(PACKAGING / "install-desktop-integration.sh"), "--prefix", str(prefix)],
+                          capture_output=True, text=True, timeout=60, env=env, cwd=tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    entry = (prefix / "applications" / DESKTOP.name).read_text(encoding="utf-8")
+    assert f'Exec="{exe}" %f' in entry, entry
+    # A relative --exec is made absolute too.
+    proc = subprocess.run([bash, str(PACKAGING / "install-desktop-integration.sh"), "--prefix", str(prefix),
+                           "--exec", "venv/bin/qtanimator"], capture_output=True, text=True, timeout=60, env=env,
+                          cwd=tmp_path)
+    assert proc.returncode == 0, proc.stdout + proc.stderr
+    assert f'Exec="{exe}" %f' in (prefix / "applications" / DESKTOP.name).read_text(encoding="utf-8")
+
+
+def test_desktop_integration_without_qtanimator_on_path_says_how_to_name_it(tmp_path: Path) -> None:
+    import os
+
+    bash = shutil.which("bash")
+    if bash is None:
+        pytest.skip("bash is not installed")
+    proc = subprocess.run([bash, str(PACKAGING / "install-desktop-integration.sh"), "--prefix", str(tmp_path)],
+                          capture_output=True, text=True, timeout=60, env={**os.environ, "PATH": "/usr/bin:/bin"})
+    assert proc.returncode == 1 and "--exec" in proc.stderr, proc.stderr
+    assert not (tmp_path / "applications").exists()
+
+
+# ------------------------------------------------------------------ numba
 def test_qtanimator_no_numba_forces_the_numpy_kernels() -> None:
-    """CI runs the cloth tests a second time with QTANIMATOR_NO_NUMBA=1: the path of a plain
-    ``pip install qtanimator`` (numba is the ``[fast]`` extra)."""
+    """CI runs the cloth tests a second time with QTANIMATOR_NO_NUMBA=1: the numpy kernels, the
+    path of a platform without numba and of the frozen app."""
     import os
 
     code = ("import sys; from qtanimator.core import cloth_kernels; from qtanimator.core.cloth import Cloth; "
