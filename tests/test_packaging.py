@@ -59,6 +59,10 @@ def test_every_subpackage_is_listed_for_the_wheel() -> None:
 
 def test_checkout_finds_its_resources_and_scenes() -> None:
     # In a checkout (and the editable install) the folders at the repository root are used.
+    if REPO not in Path(qtanimator.__file__).resolve().parents:
+        # CI's newest and oldest sets run the suite against the installed wheel, whose own
+        # folders test_wheel_contains_package_resources_and_scenes and .ci/wheel_check.sh check.
+        pytest.skip("qtanimator is the installed wheel here, not the checkout")
     assert paths.shader_path("mesh.vert").is_file()
     assert (paths.scenes_dir() / "flappy.svg").is_file()
     assert paths.demo_project().is_file()
@@ -263,7 +267,7 @@ def test_wheel_contains_package_resources_and_scenes(tmp_path: Path) -> None:
     requires = meta.get_all("Requires-Dist") or []
     assert not [r for r in requires if "==" in r.split(";")[0]], requires
     assert "numba>=0.60" in requires
-    assert 'PySide6-Essentials!=6.12.0,<7,>=6.8; python_version < "3.12"' in requires, requires
+    assert 'PySide6-Essentials!=6.12.0,<7,>=6.8.1; python_version < "3.12"' in requires, requires
     body = meta.get_payload()
     assert meta["Description-Content-Type"] == "text/markdown"
     assert "## Quick start" in body and "![" not in body

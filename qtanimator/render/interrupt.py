@@ -63,3 +63,30 @@ def interrupt_on_signals() -> Iterator[None]:
     finally:
         for s, old in previous.items():
             signal.signal(s, old if old is not None else signal.SIG_DFL)
+
+
+@contextmanager
+def signals_held() -> Iterator[None]:
+    """SIGTERM / SIGINT wait until the block ends, then raise :class:`RenderInterrupted`.
+
+    For native imports: a KeyboardInterrupt raised while PySide6 initialises aborts the
+    interpreter ("libshiboken/signature: could not initialize part 2", exit 134), which a
+    Ctrl+C in the first second of a render on a loaded machine did. Outside the main thread
+    the block runs unchanged.
+    """
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held: list[int] = []
+
+    def handler(signum: int, frame: FrameType | None) -> None:
+        held.append(signum)
+
+    previous = {s: signal.signal(s, handler) for s in HANDLED}
+    try:
+        yield
+    finally:
+        for s, old in previous.items():
+            signal.signal(s, old if old is not None else signal.SIG_DFL)
+    if held:
+        raise RenderInterrupted(held[0])

@@ -6,27 +6,13 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from samples import write_bvh
 
 from qtanimator.core.channel import Channel, Key
 from qtanimator.document import Document, UndoStack
 from qtanimator.document.character3d import set_fps_command, world_matrices
 from qtanimator.document.import3d import import_file
 from qtanimator.formats.bvh import load_bvh
-
-
-def write_bvh(path, frames: int, frame_time: str = "0.00833333"):
-    """A two-joint BVH whose root moves and turns every frame."""
-    rows = []
-    for k in range(frames):
-        rows.append(f"{k * 0.5:g} {10 + np.sin(k / 3):.6f} {-k * 0.25:g} {k * 1.5:g} {k * -0.75:g} {k * 2.0:g} "
-                    f"{k * 3.0:g} 0 {k * -1.0:g}")
-    path.write_text(
-        "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0 0\n"
-        "  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
-        "  JOINT Chest\n  {\n    OFFSET 0 5 0\n    CHANNELS 3 Zrotation Xrotation Yrotation\n"
-        "    End Site\n    {\n      OFFSET 0 4 0\n    }\n  }\n}\n"
-        f"MOTION\nFrames: {frames}\nFrame Time: {frame_time}\n" + "\n".join(rows) + "\n")
-    return path
 
 
 def _import(doc, path):

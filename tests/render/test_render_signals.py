@@ -153,6 +153,26 @@ def test_interrupt_on_signals_raises_once_and_restores_handlers():
     assert signal.getsignal(signal.SIGTERM) == before
 
 
+def test_signals_held_during_a_native_import_raise_when_it_ends():
+    """A signal while PySide6 initialises is held (a KeyboardInterrupt there aborts Python),
+    then ends the render as usual."""
+    from qtanimator.render.interrupt import signals_held
+
+    before = signal.getsignal(signal.SIGINT)
+    reached_the_end = False
+    with pytest.raises(RenderInterrupted) as info:
+        with signals_held():
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.2)  # a plain handler would raise here
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.05)
+            reached_the_end = True
+    assert reached_the_end and info.value.signum == signal.SIGINT  # the first one
+    assert signal.getsignal(signal.SIGINT) == before
+    with signals_held():  # no signal: nothing raised
+        pass
+
+
 def test_stop_private_xvfbs_waits_for_the_server(monkeypatch):
     if shutil.which("Xvfb") is None:
         pytest.skip("needs Xvfb")

@@ -12,6 +12,19 @@ from qtanimator.ui.main_window import MainWindow
 ANIMATOR_EDITORS = ("rig_editor", "timeline", "joint_tree", "properties", "export_dialog", "recovery")
 
 
+@pytest.fixture(autouse=True)
+def first_run_layout() -> None:
+    """Every widget test opens its windows as a first run: the window and dock layout a
+    previous test's window saved on closing would otherwise be restored (after a dope-sheet
+    test the 2D view of a 1200x800 window was 105 px tall and IK drags missed their targets)."""
+    from qtanimator.ui.app_settings import settings
+
+    s = settings()
+    s.remove("window/geometry")
+    s.remove("window/state")
+    s.sync()
+
+
 @pytest.fixture
 def make_window(qtbot) -> Callable[..., MainWindow]:  # type: ignore[no-untyped-def]
     """Build a real, shown main window: ``make_window(full=False, editors=ANIMATOR_EDITORS,

@@ -54,7 +54,12 @@ def test_2d_solver_choices_and_an_exact_two_bone_drag(make_window, qtbot, shared
     panel.findChild(QCheckBox, "param_ik_two_bone").setChecked(False)
     assert doc.parameters["ik.solver"] == "fabrik" and doc.parameters["ik.two_bone"] is False
     steps = window.ctx.undo_stack.count()
-    back = [moves[-1] + QPoint(10 * k, 12 * k) for k in range(1, 4)]   # towards the shoulder: in reach
+    # Towards the shoulder (joint 2's pivot, the chain's base): in reach whatever the view's
+    # scale (a layout that leaves the 2D view small makes fixed pixel steps overshoot).
+    pose = c2d.evaluate_pose(doc, asset, 0.0)
+    shoulder = view.from_scene(pose.to_world(1, doc.runtime[asset].joints[2].pivot))
+    shoulder_px = QPoint(int(shoulder.x()), int(shoulder.y()))
+    back = [moves[-1] + (shoulder_px - moves[-1]) * (0.12 * k) for k in range(1, 4)]
     _right_drag(qtbot, view.viewport(), moves[-1], back)
     assert window.ctx.undo_stack.count() == steps + 1
     target = view.to_scene(QPointF(back[-1]))

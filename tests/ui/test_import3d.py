@@ -200,8 +200,7 @@ def test_opened_character_is_framed_in_the_3d_view(qtbot, shared_data, dialog_lo
 
 def test_a_clip_at_another_rate_is_offered_in_the_status_bar(window, tmp_path, dialog_log):
     from PySide6.QtWidgets import QPushButton
-
-    from tests.document.test_import_timing import write_bvh
+    from samples import write_bvh
 
     doc = window.doc
     doc.apply_channel("other/j/x", _two_keys())  # a document with keys: the rate is only offered
