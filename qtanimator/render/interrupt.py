@@ -15,6 +15,7 @@ import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
 from types import FrameType
+from typing import Any
 
 HANDLED = (signal.SIGTERM, signal.SIGINT)
 
@@ -61,8 +62,7 @@ def interrupt_on_signals() -> Iterator[None]:
     try:
         yield
     finally:
-        for s, old in previous.items():
-            signal.signal(s, old if old is not None else signal.SIG_DFL)
+        _restore(previous)
 
 
 @contextmanager
@@ -86,7 +86,11 @@ def signals_held() -> Iterator[None]:
     try:
         yield
     finally:
-        for s, old in previous.items():
-            signal.signal(s, old if old is not None else signal.SIG_DFL)
+        _restore(previous)
     if held:
         raise RenderInterrupted(held[0])
+
+
+def _restore(previous: dict[signal.Signals, Any]) -> None:
+    for s, old in previous.items():
+        signal.signal(s, old if old is not None else signal.SIG_DFL)

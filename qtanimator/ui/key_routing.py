@@ -18,6 +18,7 @@ from PySide6.QtGui import QCursor, QKeyEvent
 from PySide6.QtWidgets import QAbstractItemView, QApplication, QWidget
 
 from qtanimator.ui.timeline import KEY_TARGETS
+from qtanimator.ui.widgets import install_app_filter
 
 #: The views (by object name) whose letter keys follow the mouse: the editors that also get
 #: the timeline's keys.
@@ -61,16 +62,7 @@ class ViewKeyRouter(QObject):
 
 def install_view_key_router(app: QApplication | None = None) -> ViewKeyRouter | None:
     """Install :class:`ViewKeyRouter` on the application (once; later calls return it)."""
-    app = app or QApplication.instance()  # type: ignore[assignment]
-    if app is None:
-        return None
-    existing = app.findChild(ViewKeyRouter, "qtanimatorViewKeyRouter")
-    if existing is not None:
-        return existing
-    router = ViewKeyRouter(app)
-    router.setObjectName("qtanimatorViewKeyRouter")
-    app.installEventFilter(router)
-    return router
+    return install_app_filter(ViewKeyRouter, "qtanimatorViewKeyRouter", app)
 
 
 __all__ = ["COMMAND_MODIFIERS", "VIEWS", "ViewKeyRouter", "install_view_key_router", "is_letter_key",

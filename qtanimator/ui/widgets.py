@@ -23,7 +23,7 @@
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import Any, TypeVar
 
 from PySide6.QtCore import QEvent, QObject, QPointF, Qt, Signal
 from PySide6.QtGui import QKeyEvent, QKeySequence, QValidator, QWheelEvent
@@ -138,18 +138,27 @@ class DockBehaviour(QObject):
         return False
 
 
-def install_dock_behaviour(app: QApplication | None = None) -> DockBehaviour | None:
-    """Install :class:`DockBehaviour` on the application (once; later calls return it)."""
+FilterT = TypeVar("FilterT", bound=QObject)
+
+
+def install_app_filter(kind: type[FilterT], name: str, app: QApplication | None = None) -> FilterT | None:
+    """Install one event filter of ``kind`` (a QObject made with the application as its
+    parent) on the whole application, once: later calls return the one named ``name``."""
     app = app or QApplication.instance()  # type: ignore[assignment]
     if app is None:
         return None
-    existing = app.findChild(DockBehaviour, "qtanimatorDockBehaviour")
+    existing = app.findChild(kind, name)
     if existing is not None:
         return existing
-    behaviour = DockBehaviour(app)
-    behaviour.setObjectName("qtanimatorDockBehaviour")
-    app.installEventFilter(behaviour)
-    return behaviour
+    installed = kind(app)
+    installed.setObjectName(name)
+    app.installEventFilter(installed)
+    return installed
+
+
+def install_dock_behaviour(app: QApplication | None = None) -> DockBehaviour | None:
+    """Install :class:`DockBehaviour` on the application (once; later calls return it)."""
+    return install_app_filter(DockBehaviour, "qtanimatorDockBehaviour", app)
 
 
 def wrap_long_rows(widget: QWidget) -> None:
@@ -309,6 +318,7 @@ class CheckedSpinBox(_Checked, QSpinBox):
 
 
 __all__ = [
-    "CheckedDoubleSpinBox", "CheckedSpinBox", "DockBehaviour", "install_dock_behaviour", "is_undo_key",
+    "CheckedDoubleSpinBox", "CheckedSpinBox", "DockBehaviour", "install_app_filter", "install_dock_behaviour",
+    "is_undo_key",
     "takes_wheel_only_when_focused", "text_being_edited",
 ]
