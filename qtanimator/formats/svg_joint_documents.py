@@ -5,6 +5,8 @@ Each joint's document is cut from the numbered XML tree (see
 ancestors, and the resources they refer to, in the reader's frame. Qt's SVG renderer
 misses some SVG, so the documents also inline ``<symbol>`` uses, turn clip paths into
 masks and write functional colours (``rgba()``, ``hsl()``) as ``#rrggbb`` and an opacity.
+Every ``<image>`` is checked and inlined (:mod:`qtanimator.formats.svg_images`): QtSvg gets
+only ``data:`` URIs and never opens a file.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ from typing import Any
 import svgelements as se
 
 from qtanimator.formats.svg_builder import _QID, _float, _local
+from qtanimator.formats.svg_images import ImageGate
 
 _SVG_NS = "http://www.w3.org/2000/svg"
 _XLINK_NS = "http://www.w3.org/1999/xlink"
@@ -48,9 +51,13 @@ def _matrix_of(value: Any) -> tuple[float, float, float, float, float, float]:
 class _JointDocuments:
     """Standalone SVG documents of the joints, cut from the numbered XML tree."""
 
-    def __init__(self, root: ET.Element, frame: tuple[float, float, float, float, float, float]) -> None:
+    def __init__(self, root: ET.Element, frame: tuple[float, float, float, float, float, float],
+                 images: ImageGate | None = None) -> None:
         self.root = root
         self.frame = frame
+        #: Checks and inlines every ``<image>`` of each document (QtSvg gets only ``data:``
+        #: URIs); without one, images lose their references.
+        self.images = images if images is not None else ImageGate(None)
         self.parent = {c: p for p in root.iter() for c in p}
         self.by_qid = {el.get(_QID): el for el in root.iter()}
         refs: set[str] = set()
@@ -103,6 +110,7 @@ class _JointDocuments:
         _inline_symbols(root)
         _clips_as_masks(root)
         _plain_colors(root)
+        self.images.clean(root)
         return ET.tostring(root, encoding="unicode")
 
 

@@ -40,6 +40,7 @@ from qtanimator.formats._svg_budget import check_budget
 from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.errors import FormatError
 from qtanimator.formats.svg_builder import _QID, _box_centre, _Builder, _elements, _empty, _local, _NotARig, _number
+from qtanimator.formats.svg_images import ImageGate
 from qtanimator.formats.svg_joint_documents import _JointDocuments, _matrix_of
 from qtanimator.formats.svg_rig_spec import _add_candidates, _derived_spec, _element_refs, _from_spec
 
@@ -137,9 +138,11 @@ def parse_character(data: bytes, name: str, path: str | os.PathLike[str] | None 
             builder.warnings.append("markers with orient=\"auto\" are drawn unrotated (the SVG renderer "
                                     "does not turn them along the line).")
         frame = _matrix_of(getattr(svg, "viewbox_transform", None))
-        docs = _JointDocuments(root, frame)
+        images = ImageGate(None if path is None else Path(os.path.abspath(path)).parent)
+        docs = _JointDocuments(root, frame, images)
         for joint, (keep, drop) in zip(joints, builder.scopes):
             joint.svg = docs.document(keep, drop)
+        builder.warnings.extend(images.warnings)
         with np.errstate(all="ignore"):  # huge coordinates are reported below, not warned about
             character = Character(name, joints, source=None if path is None else str(path),
                                   warnings=builder.warnings)
