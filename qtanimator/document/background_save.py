@@ -23,7 +23,7 @@ from concurrent.futures import Future, ThreadPoolExecutor
 from pathlib import Path
 
 from qtanimator.formats.atomic import write_chunks_atomic
-from qtanimator.formats.project import ProjectData, project_json_parts
+from qtanimator.formats.project import ProjectData, json_utf8, project_json_parts
 
 log = logging.getLogger(__name__)
 
@@ -177,7 +177,7 @@ def _chunks(job: SaveJob) -> Iterator[bytes]:
     for part in project_json_parts(job.data, job.path.parent):
         if job.stopped():
             raise _Stopped
-        yield part.encode("utf-8")
+        yield json_utf8(part)  # a file name that is not UTF-8 stays saveable (an escape)
     if job.stopped():
         raise _Stopped
 

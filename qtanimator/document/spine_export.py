@@ -34,7 +34,6 @@ import math
 import os
 import re
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -44,6 +43,7 @@ from qtanimator.core.rig2d import Character
 from qtanimator.document.character2d_asset import character
 from qtanimator.document.document import Document
 from qtanimator.document.evaluation2d import evaluate_pose, placement_matrix
+from qtanimator.formats.atomic import write_text_atomic
 
 FloatArray = npt.NDArray[np.float64]
 
@@ -201,5 +201,5 @@ def write_spine_json(doc: Document, asset_id: str, path: str | os.PathLike[str],
                      pixels_per_unit: float = PIXELS_PER_UNIT, margin: float = MARGIN) -> dict[str, Any]:
     """Write the JSON part only (``NAME.json``); returns the data written."""
     data = spine_skeleton(doc, asset_id, pixels_per_unit, margin)
-    Path(path).write_text(json.dumps(data, indent=1) + "\n", encoding="utf-8")
+    write_text_atomic(path, json.dumps(data, indent=1) + "\n")  # atomic; a pipe or a device is refused
     return data

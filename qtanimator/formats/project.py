@@ -231,7 +231,19 @@ def save_project(data: Any, path: str | os.PathLike[str]) -> None:
     if not isinstance(data, ProjectData):
         data = data.to_project_data()
     target = Path(path)
-    write_chunks_atomic(target, (part.encode("utf-8") for part in project_json_parts(data, target.parent)))
+    write_chunks_atomic(target, (json_utf8(part) for part in project_json_parts(data, target.parent)))
+
+
+def json_utf8(part: str) -> bytes:
+    """Part of a project's JSON text as UTF-8. A file name that is not UTF-8 (legal on
+    Linux) reaches us as ``os.fsdecode`` gives it: each undecodable byte a lone surrogate
+    U+DC80…U+DCFF, which UTF-8 cannot store. It is written as the JSON escape ``\\udcXX``
+    (only ever inside a JSON string), which ``json.loads`` gives back as the same
+    character, so ``os.fsencode`` of the loaded path yields the file's exact bytes."""
+    try:
+        return part.encode("utf-8")
+    except UnicodeEncodeError:
+        return part.encode("utf-8", "backslashreplace")
 
 
 def load_project(path: str | os.PathLike[str]) -> ProjectData:

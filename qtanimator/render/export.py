@@ -18,7 +18,6 @@ the output location can be written before anything is rendered).
 
 from __future__ import annotations
 
-import contextlib
 import errno
 import io
 import math
@@ -32,7 +31,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from qtanimator.formats.atomic import mode_for, write_atomic
+from qtanimator.formats.atomic import (
+    remove_stale_temporaries,
+    replacing,
+    writable_target,
+    write_atomic,
+    write_chunks_atomic,
+)
 
 VIDEO_SUFFIXES = {".mp4": "libx264", ".mov": "libx264", ".mkv": "libx264", ".avi": "mpeg4",
                   ".webm": "libvpx-vp9"}
@@ -118,8 +123,8 @@ def check_output(out: str | os.PathLike[str]) -> str:
     ValueError (a bad name or format) or OSError naming the real path. Creates nothing."""
     kind = output_kind(out)
     path = os.path.abspath(os.fspath(out))
-    if kind in ("gif", "video") and os.path.isdir(path):
-        raise IsADirectoryError(errno.EISDIR, "it is a folder", path)
+    if kind in ("gif", "video"):
+        writable_target(path)  # a folder, a pipe, a device: refused (a link: its file is written)
     folder = path if kind == "folder" else os.path.dirname(path)
     probe = folder
     while not os.path.lexists(probe):
@@ -239,13 +244,13 @@ def write_frames(frames: Iterable[npt.ArrayLike | EncodedPng], out: str | os.Pat
             parent = os.path.dirname(path)
             if parent:
                 os.makedirs(parent, exist_ok=True)
+        remove_stale_temporaries(Path(pattern))  # once, not per frame
         for a in _checked_frames(frames, progress, cancel, keep_encoded=True):
             name = pattern % (start + count)
-            if isinstance(a, EncodedPng):
-                with open(name, "wb") as f:  # encoded by a render worker: the bytes as they are
-                    f.write(a.data)
-            else:
-                iio.imwrite(name, a)
+            # encoded by a render worker: the bytes as they are; a frame file that is a pipe
+            # or a device is refused, a half-written frame never replaces an old one
+            data = a.data if isinstance(a, EncodedPng) else bytes(iio.imwrite("<bytes>", a, extension=".png"))
+            write_chunks_atomic(name, (data,), sync=False, clean=False)
             count += 1
         return count
     parent = os.path.dirname(os.path.abspath(path))
@@ -265,61 +270,31 @@ def write_frames(frames: Iterable[npt.ArrayLike | EncodedPng], out: str | os.Pat
             buffer = io.BytesIO()
             images[0].save(buffer, format="GIF", save_all=True, append_images=images[1:], loop=0,
                            duration=[10 * d for d in delays], optimize=False)
-            try:
-                write_atomic(path, buffer.getvalue())  # a failed export leaves the old file intact
-            except OSError as exc:
-                raise _naming(exc, path) from None
+            write_atomic(path, buffer.getvalue())  # a failed export leaves the old file intact
         return count
     import imageio.v2 as iio2
 
     codec = VIDEO_SUFFIXES[Path(path).suffix.lower()]
     # ffmpeg writes a temporary file beside the target (same suffix: it picks the container
-    # from it), which replaces the target only once the video is complete.
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{Path(path).name}.", suffix=Path(path).suffix, dir=parent)
-    except OSError as exc:
-        raise _naming(exc, path) from None
-    os.close(fd)
+    # from it; the process id in its name lets the next render remove what a killed one
+    # left), which replaces the target only once the video is complete.
     writer = None
-    done = False
-    try:
-        for a in _checked_frames(frames, progress, cancel):
-            if writer is None:
-                writer = iio2.get_writer(tmp, format="FFMPEG", mode="I", fps=float(fps), codec=codec,
-                                         macro_block_size=1, quality=8, pixelformat="yuv420p",
-                                         output_params=["-movflags", "+faststart"] if codec == "libx264" else None)
-            writer.append_data(_even(flatten_alpha(a)))
-            count += 1
-        if writer is not None:
-            writer.close()
-            writer = None
-            _replace_keeping_mode(tmp, path)
-            done = True
-    except OSError as exc:
-        raise _naming(exc, path, tmp) from None
-    finally:
-        if writer is not None:
-            writer.close()
-        if not done:
-            with contextlib.suppress(OSError):
-                os.unlink(tmp)
+    with replacing(path, suffix=Path(path).suffix.lower()) as tmp:
+        try:
+            for a in _checked_frames(frames, progress, cancel):
+                if writer is None:
+                    writer = iio2.get_writer(tmp.path, format="FFMPEG", mode="I", fps=float(fps), codec=codec,
+                                             macro_block_size=1, quality=8, pixelformat="yuv420p",
+                                             output_params=["-movflags", "+faststart"] if codec == "libx264"
+                                             else None)
+                writer.append_data(_even(flatten_alpha(a)))
+                count += 1
+        finally:
+            if writer is not None:
+                writer.close()
+        if writer is None:
+            tmp.discard()  # no frames: the old file stays
     return count
-
-
-def _naming(exc: OSError, path: str, tmp: str | None = None) -> OSError:
-    """``exc`` reported under the output's name instead of the hidden temporary file beside it."""
-    name = os.path.basename(str(exc.filename or ""))
-    if exc.filename is not None and (name.startswith(f".{Path(path).name}.") or name.startswith(".tmp")):
-        return OSError(exc.errno, exc.strerror, path)
-    if exc.filename is None and tmp and tmp in str(exc):
-        return OSError(str(exc).replace(tmp, path))
-    return exc
-
-
-def _replace_keeping_mode(tmp: str, target: str) -> None:
-    """``os.replace`` with the old file's mode, or the mode a plain ``open`` would give."""
-    os.chmod(tmp, mode_for(target))
-    os.replace(tmp, target)
 
 
 def count_video_frames(path: str | os.PathLike[str]) -> int:

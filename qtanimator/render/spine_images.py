@@ -10,13 +10,14 @@ import os
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import Qt
+from PySide6.QtCore import QBuffer, QByteArray, QIODevice, Qt
 from PySide6.QtGui import QImage, QPainter
 
 from qtanimator.core.rig2d import Character, Joint
 from qtanimator.document.character2d import character
 from qtanimator.document.document import Document
 from qtanimator.document.spine_export import MARGIN, PIXELS_PER_UNIT, Region, regions, write_spine_json
+from qtanimator.formats.atomic import write_atomic
 from qtanimator.render.painter2d import draw_character
 
 
@@ -48,6 +49,12 @@ def export_spine(doc: Document, asset_id: str, path: str | os.PathLike[str],
     ch = character(doc, asset_id)
     for r in regions(ch, pixels_per_unit, margin):
         target = folder / f"{r.file}.png"
-        if not joint_image(ch, r, pixels_per_unit).save(str(target)):
-            raise OSError(f"could not write {target}")
+        png = QByteArray()
+        buffer = QBuffer(png)
+        buffer.open(QIODevice.OpenModeFlag.WriteOnly)
+        # the stubs want the format as bytes, PySide6 takes a str
+        if not joint_image(ch, r, pixels_per_unit).save(buffer, "PNG"):  # type: ignore[call-overload]
+            raise OSError(f"could not encode the image of {target}")
+        buffer.close()
+        write_atomic(target, bytes(png.data()))  # atomic; a pipe or a device is refused
     return write_spine_json(doc, asset_id, out, pixels_per_unit, margin)

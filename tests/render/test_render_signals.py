@@ -65,7 +65,7 @@ def _x_lock_files(pid: int) -> list[Path]:
 
 
 def _temporaries(folder: Path) -> list[Path]:
-    return [p for p in folder.iterdir() if p.name.startswith(".out.")]
+    return [p for p in folder.iterdir() if p.name.startswith((".out.", ".qtanim-"))]
 
 
 def _interrupt_render(tmp_path: Path, scene: str, view: str, out_name: str, signum: int,
