@@ -25,8 +25,20 @@ import numpy.typing as npt
 
 FloatArray = npt.NDArray[np.float64]
 
-__all__ = ["PERIODIC", "TCB_FIELDS", "Extrapolation", "Interpolation", "Key", "Tangent", "resolve_slopes",
-           "rule_and_slope"]
+#: Two key times closer than this (seconds) are the same time: editing treats them as one
+#: key, and a project or glTF file whose keys of one channel are closer is refused.
+KEY_TIME_TOLERANCE = 1e-6
+#: The largest key time (seconds, either sign) a file may hold: 11.6 days of animation.
+#: Beyond it, spans and frame numbers lose the precision the views need.
+MAX_KEY_TIME = 1e6
+#: The largest key value, fixed slope (value per second), tangent weight (seconds) or
+#: Kochanek–Bartels parameter a project may hold (either sign). Sums and products of a few
+#: such numbers stay finite, so no view computes an infinite or NaN range from them.
+MAX_KEY_VALUE = 1e9
+
+__all__ = ["KEY_TIME_TOLERANCE", "MAX_KEY_TIME", "MAX_KEY_VALUE", "PERIODIC", "TCB_FIELDS",
+           "Extrapolation", "Interpolation", "Key", "Tangent", "bounds_problem",
+           "resolve_slopes", "rule_and_slope"]
 
 
 class Tangent(StrEnum):
@@ -364,3 +376,35 @@ def _tcb_slopes(keys: Sequence[Key], times: FloatArray, values: FloatArray,
         s_in[1:-1] = 0.5 * t * ((1 + b) * (1 - c) * d0 + (1 - b) * (1 + c) * d1) * per_second
     return s_in, s_out
 
+
+
+def bounds_problem(keys: Sequence[Key]) -> str | None:
+    """Why ``keys`` (sorted by time) hold a number a file may not hold, naming the property
+    as a project file spells it (``"times"``, ``"values"``, ``"in"``…), or None: times within
+    ±:data:`MAX_KEY_TIME` and at least :data:`KEY_TIME_TOLERANCE` apart; values, fixed
+    slopes, weights and Kochanek–Bartels parameters within ±:data:`MAX_KEY_VALUE`.
+
+    Within these bounds a channel's spans, slopes and extrapolation stay finite, so no view
+    computes a NaN range from them (issue 31)."""
+    if not keys:
+        return None
+    times = np.fromiter((k.time for k in keys), np.float64, len(keys))
+    values = np.fromiter((k.value for k in keys), np.float64, len(keys))
+    far = np.flatnonzero(np.abs(times) > MAX_KEY_TIME)
+    if far.size:
+        return f"\"times\" holds {float(times[far[0]])!r}, beyond the limit of ±{MAX_KEY_TIME:g} seconds"
+    gaps = np.diff(times)
+    if gaps.size and float(gaps.min()) < KEY_TIME_TOLERANCE:
+        i = int(np.argmin(gaps))
+        return (f"\"times\" holds keys at {float(times[i])!r} and {float(times[i + 1])!r} s, closer than the "
+                f"{KEY_TIME_TOLERANCE:g} s that keys of one channel must be apart")
+    big = np.flatnonzero(np.abs(values) > MAX_KEY_VALUE)
+    if big.size:
+        return f"\"values\" holds {float(values[big[0]])!r}, beyond the limit of ±{MAX_KEY_VALUE:g}"
+    for k in keys:
+        for name, value in (("in", k.in_slope), ("out", k.out_slope), ("in_weight", k.in_weight),
+                            ("out_weight", k.out_weight), ("tension", k.tension),
+                            ("continuity", k.continuity), ("bias", k.bias)):
+            if value is not None and abs(value) > MAX_KEY_VALUE:
+                return f"\"{name}\" of the key at {k.time!r} s is {value!r}, beyond the limit of ±{MAX_KEY_VALUE:g}"
+    return None

@@ -146,11 +146,24 @@ class ClothCache:
 
 
 def load_cloth_asset(asset: Asset) -> ClothCache:
-    """The loader for cloth assets (registered in ``qtanimator.document.loaders``)."""
+    """The loader for cloth assets (registered in ``qtanimator.document.loaders``).
+
+    The sizes and placement that reach the 3D camera (:data:`PLACED`) must lie within the
+    schema's ranges (a cloth 1e308 m wide has no finite bounding box); the other parameters
+    are checked by :meth:`ClothParams.validate`."""
+    from qtanimator.document.parameters import CLOTH
+
     try:
+        for name in PLACED:
+            if asset.properties.get(name) is not None:
+                CLOTH[name].validate(asset.properties[name], f"{asset.id}.{name}")
         return ClothCache(asset.properties)
-    except (ValueError, TypeError, KeyError) as exc:
+    except (ValueError, TypeError, KeyError, ArithmeticError) as exc:
         raise FormatError(f"cloth '{asset.id}' has an invalid parameter: {exc}") from exc
+
+
+#: Cloth properties whose schema range is enforced when a project is opened.
+PLACED = ("width", "height", "origin")
 
 
 def add_cloth_command(doc: Document, params: ClothParams | None = None, asset_id: str | None = None) -> Command:

@@ -47,8 +47,10 @@ def _load_runtime(asset: Asset) -> Any:
     return load_runtime(asset)
 
 
-def document_from_project_data(data: ProjectData) -> Document:
-    """Build a document and load every asset's source (FormatError if one fails)."""
+def document_from_project_data(data: ProjectData, path: str | os.PathLike[str] | None = None) -> Document:
+    """Build a document and load every asset's source (FormatError if one fails).
+
+    ``path`` is the project file: an error of a loader that names no file names it."""
     doc = Document(channels=data.channels, parameters=data.parameters)  # defaults fill in the rest
     doc.view_state = dict(data.view)
     for rec in data.assets:
@@ -59,6 +61,15 @@ def document_from_project_data(data: ProjectData) -> Document:
         except OSError as exc:  # a loader that let a missing or unreadable file through
             raise FormatError(f"asset {asset.id!r}: cannot read {exc.filename or asset.source!r} "
                               f"({exc.strerror or exc}).", rec.source) from exc
+        except FormatError as exc:
+            if exc.path is not None or path is None:
+                raise
+            raise FormatError(exc.message, path, exc.line, exc.column) from exc
+        except (TypeError, ValueError, KeyError, IndexError, ArithmeticError) as exc:
+            # A safety net: the project reader checks the types every loader relies on.
+            text = str(exc)
+            raise FormatError(f"asset {asset.id!r} ({asset.kind}) has a property of the wrong kind or size "
+                              f"({type(exc).__name__}: {text[:120]}).", path) from exc
         if runtime is not None:
             doc.runtime[asset.id] = runtime
     return doc
@@ -91,7 +102,7 @@ def open_document_relinked(path: str | os.PathLike[str],
     file is still missing."""
     data = load_project(path)
     relinks = relink_missing(data, Path(path).resolve().parent, locate)
-    doc = document_from_project_data(data)
+    doc = document_from_project_data(data, path)
     doc.path = str(Path(path).resolve())
     return doc, relinks
 

@@ -40,12 +40,13 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from qtanimator.core.channel import Channel, Key
+from qtanimator.core.keys import KEY_TIME_TOLERANCE
 from qtanimator.document import character2d, character3d
 from qtanimator.document.commands import DeleteKeys, SetChannels, moved_key
 from qtanimator.document.document import DEFAULT_FPS, Document, channel_id, split_channel_id
 
-#: Two key times closer than this (seconds) are the same time.
-TIME_TOLERANCE = 1e-6
+#: Two key times closer than this (seconds) are the same time (the one constant of core.keys).
+TIME_TOLERANCE = KEY_TIME_TOLERANCE
 #: A pasted or retimed frame number this close to a whole frame is put exactly on it.
 FRAME_TIDY = 1e-6
 

@@ -40,6 +40,7 @@ from typing import Any
 
 from qtanimator.core.channel import Channel, Extrapolation, Interpolation, Key, Tangent
 from qtanimator.core.clip import AnimationClip
+from qtanimator.core.keys import bounds_problem
 from qtanimator.formats._tokens import Tokens, read_text, show
 from qtanimator.formats.atomic import write_text_atomic
 from qtanimator.formats.errors import FormatError
@@ -129,6 +130,9 @@ def _parse_channel(tk: Tokens, index: int) -> Channel:
             keys = _parse_keys(tk, label)
         else:
             tk.error(f"expected 'extrapolate', 'keys' or '}}' in {label}, found '{show(word)}'.", tk.pos - 1)
+    problem = bounds_problem(keys or [])
+    if problem is not None:  # the bounds a project holds (issue 31), so that a saved import opens again
+        raise FormatError(f"{label}: {problem.replace(chr(34), chr(39))}.", tk.path, tk.line(tk.pos - 1))
     try:
         return Channel(keys or [], pre, post)
     except ValueError as exc:  # pragma: no cover - _parse_keys checks the order itself

@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from qtanimator.core.keys import KEY_TIME_TOLERANCE, MAX_KEY_TIME, MAX_KEY_VALUE
 from qtanimator.formats.bvh_clip import CHANNEL_NAMES, BvhClip, BvhJoint, FloatArray
 from qtanimator.formats.errors import FormatError
 
@@ -115,6 +116,11 @@ class _Parser:
         built = self.build_joints(joints)
         ncols = sum(len(j.channels) for j in built)
         motion, warnings = self.motion(frames, ncols, ftok)
+        if len(motion) * frame_time > MAX_KEY_TIME:  # the rows read: a declared count may lie
+            raise self.error(f"{len(motion)} frames of {frame_time:g} s last beyond qtanimator's limit of "
+                             f"{MAX_KEY_TIME:g} seconds.", ftok)
+        if motion.size and not float(np.max(np.abs(motion))) <= MAX_KEY_VALUE:
+            raise self.error(f"the motion holds a value beyond qtanimator's limit of ±{MAX_KEY_VALUE:g}.", ftok)
         for w in warnings:
             log.warning("%s: %s", os.path.basename(self.path) if self.path else "BVH", w)
         return BvhClip(built, frame_time, motion, self.path, warnings)
@@ -229,6 +235,9 @@ class _Parser:
         value = self.to_float(ttok, "the frame time in seconds")
         if not value > 0.0:
             raise self.error(f"the frame time must be positive, found {ttok.text}.", ttok)
+        if not KEY_TIME_TOLERANCE <= value <= MAX_KEY_TIME:  # keys a channel can hold (issue 31)
+            raise self.error(f"the frame time must lie within {KEY_TIME_TOLERANCE:g} and {MAX_KEY_TIME:g} seconds, "
+                             f"found {ttok.text}.", ttok)
         return value
 
     def motion(self, frames: int, ncols: int, ftok: _Tok) -> tuple[FloatArray, list[str]]:

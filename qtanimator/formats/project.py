@@ -56,6 +56,7 @@ from pathlib import Path
 from typing import Any
 
 from qtanimator.core.channel import Channel
+from qtanimator.core.keys import bounds_problem
 from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.atomic import write_chunks_atomic
 from qtanimator.formats.errors import FormatError
@@ -321,6 +322,7 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
                 raise FormatError(f"asset {a['id']!r}: its {key} {stored!r} lies outside the project's folder, "
                                   "and the project does not record that file as chosen (\"outside\"). Move the "
                                   "file into the project's folder, or add it again with File ▸ Open.", p)
+        _check_asset_properties(a["id"], a.get("properties", {}), p)
         data.assets.append(AssetRecord(a["id"], a["kind"], abs_source, props, list(outside)))
     channels = obj.get("channels", {})
     if not isinstance(channels, dict):
@@ -329,7 +331,7 @@ def parse_project(text: str, path: str | os.PathLike[str]) -> ProjectData:
         if cid.count("/") < 2 or not isinstance(ch, dict):
             raise FormatError(f"channel {cid!r} is not of the form asset/joint/dof with an object value.", p)
         try:
-            data.channels[cid] = _channel_from_json(ch)
+            data.channels[cid] = _check_channel_bounds(_channel_from_json(ch))
         except (KeyError, TypeError, ValueError, OverflowError) as exc:
             raise FormatError(f"channel {cid!r} is malformed: {exc}.", p) from exc
     return data
@@ -351,6 +353,45 @@ def _check_parameters(params: dict[str, Any], p: Path) -> None:
         value = params.get(name, 0)
         if isinstance(value, bool) or not isinstance(value, int) or abs(value) > 10**9:
             raise FormatError(f"\"{name}\" must be a whole frame number, not {value!r}.", p)
+
+
+#: The largest ``index`` (which character of an SVG folder) a project may name.
+MAX_ASSET_INDEX = 100_000
+
+
+def _check_asset_properties(asset_id: str, props: dict[str, Any], p: Path) -> None:
+    """Properties whose type every loader relies on: ``*_file`` names are paths (text or
+    null), ``index`` a whole number from 0 to :data:`MAX_ASSET_INDEX`."""
+    for name, value in props.items():
+        if name.endswith("_file") and value is not None and not isinstance(value, str):
+            raise FormatError(f"asset {asset_id!r}: the property \"{name}\" must be a file path (text), "
+                              f"not {_kind_of(value)}.", p)
+    if "index" in props:
+        index = props["index"]
+        if isinstance(index, bool) or not isinstance(index, int) or not 0 <= index <= MAX_ASSET_INDEX:
+            raise FormatError(f"asset {asset_id!r}: the property \"index\" must be a whole number from 0 to "
+                              f"{MAX_ASSET_INDEX}, not {_kind_of(index)}.", p)
+
+
+def _kind_of(value: Any) -> str:
+    """A short description of a JSON value for an error (never a long quote)."""
+    if isinstance(value, bool) or value is None:
+        return json.dumps(value)
+    if isinstance(value, (int, float)):
+        return repr(value) if len(repr(value)) <= 24 else "a number"
+    if isinstance(value, str):
+        return repr(value) if len(value) <= 24 else "a long text"
+    return "a list" if isinstance(value, list) else "an object"
+
+
+def _check_channel_bounds(channel: Channel) -> Channel:
+    """``channel``, or ValueError naming the property unless every number of it is one the
+    views and the evaluation can use (:func:`qtanimator.core.keys.bounds_problem`;
+    docs/formats.md, "Projects")."""
+    problem = bounds_problem(channel.keys)
+    if problem is not None:
+        raise ValueError(problem)
+    return channel
 
 
 def _parse_float(text: str) -> float:

@@ -358,7 +358,9 @@ def read_spine(path: str | os.PathLike[str]) -> SpineData:
     version = sk.get("spine")
     if version is not None and not isinstance(version, str):
         raise FormatError("\"skeleton\".\"spine\" must be a version text such as \"4.1.24\".", p)
-    if version is not None and version.split(".")[0].isdigit() and int(version.split(".")[0]) < 4:
+    major = version.split(".")[0] if version is not None else ""
+    # isdigit() is true of "²" and other digits int() does not read: ASCII digits only.
+    if version is not None and major.isascii() and major.isdigit() and len(major) < 6 and int(major) < 4:
         raise FormatError(f"the file is Spine {version} data; qtanimator reads the Spine 4 format "
                           "(export it again from Spine 4).", p)
     fps = _number(sk, "fps", 30.0, "\"skeleton\"", p)

@@ -10,6 +10,7 @@ kept until the content, the view or the selection changes, so moving the playhea
 
 from __future__ import annotations
 
+import math
 from collections.abc import Iterable, Mapping
 from typing import Any
 
@@ -40,6 +41,8 @@ FloatArray = npt.NDArray[np.float64]
 
 MIN_PX_PER_FRAME = 0.02
 MAX_PX_PER_FRAME = 120.0
+#: The farthest frame the sheet frames (a project's keys lie within 1e6 s × 10000 fps).
+MAX_FRAME = 1e12
 
 
 class DopeSheetCanvas(QWidget):
@@ -275,7 +278,11 @@ class DopeSheetCanvas(QWidget):
 
     # --------------------------------------------------------------- view
     def frame_range(self, lo: float, hi: float) -> None:
-        """Show frames ``lo``…``hi`` across the key area (with a small margin)."""
+        """Show frames ``lo``…``hi`` across the key area (with a small margin). A bound
+        that is not finite, or beyond :data:`MAX_FRAME`, gives the document's frame range:
+        no NaN reaches the drawing (issue 31)."""
+        if not (math.isfinite(lo) and math.isfinite(hi) and abs(lo) <= MAX_FRAME and abs(hi) <= MAX_FRAME):
+            lo, hi = (float(v) for v in self.doc.frame_range)
         width = self.key_area().width()
         span = max(hi - lo, 1.0)
         margin = span * 0.04 + 1.0

@@ -407,7 +407,7 @@ class MainWindow(QMainWindow):
         """After opening a project: go to the frame it was saved at (when it has one)."""
         stored = self.doc.view_state.get(FRAME_VIEW_STATE)
         if isinstance(stored, (int, float)) and not isinstance(stored, bool) and stored == stored \
-                and abs(stored) != float("inf"):
+                and abs(stored) <= 1e12:  # a frame a view can show (issue 31): not 1e308
             self.ctx.set_frame(float(stored))
 
     def prepare_save(self) -> None:

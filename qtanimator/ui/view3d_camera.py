@@ -18,6 +18,23 @@ from qtanimator.ui.view3d_base import ViewPart
 
 #: The document parameter holding the 3D camera (view state, written when saving).
 CAMERA_PARAMETER = "view3d.camera"
+#: The farthest a box the camera frames may reach (metres): beyond it the view matrices
+#: lose every digit, and an infinite or NaN box would make the camera NaN (issue 31).
+MAX_FRAMED_COORDINATE = 1e9
+
+
+def framable(bounds: tuple[np.ndarray, np.ndarray] | None) -> tuple[np.ndarray, np.ndarray] | None:
+    """``bounds`` when the camera can frame it: finite and within ±:data:`MAX_FRAMED_COORDINATE`;
+    else None (the camera stays where it is)."""
+    if bounds is None:
+        return None
+    lo, hi = (np.asarray(b, dtype=float) for b in bounds)
+    if lo.shape != (3,) or hi.shape != (3,):
+        return None
+    corners = np.concatenate([lo, hi])
+    if not (np.isfinite(corners).all() and float(np.max(np.abs(corners))) <= MAX_FRAMED_COORDINATE):
+        return None
+    return lo, hi
 
 
 class CameraNavigation(ViewPart):
@@ -41,6 +58,9 @@ class CameraNavigation(ViewPart):
             if target.shape != (3,) or not np.all(np.isfinite(target)) or not all(
                     math.isfinite(v) for v in (camera.azimuth, camera.inclination, camera.distance, camera.fov_y)):
                 raise ValueError("bad stored camera")
+            if framable((target, target)) is None or not 0.0 < camera.distance <= MAX_FRAMED_COORDINATE \
+                    or not 0.0 < camera.fov_y < 180.0 or max(abs(camera.azimuth), abs(camera.inclination)) > 1e6:
+                raise ValueError("stored camera out of range")
             camera.target = target
         except (TypeError, ValueError):
             self._framed_once = False
@@ -109,9 +129,13 @@ class CameraNavigation(ViewPart):
             self.ctx.doc.set_view_state(CAMERA_PARAMETER, self.camera_state())
 
     def frame_bounds(self, bounds: tuple[np.ndarray, np.ndarray]) -> None:
-        """Point the camera at a box (a new 3D asset frames itself this way)."""
-        self.camera.frame(*bounds)
-        self.options.grid_scale = grid_scale_for(*bounds)
+        """Point the camera at a box (a new 3D asset frames itself this way); a box that is
+        not :func:`framable` leaves the camera as it is."""
+        found = framable(bounds)
+        if found is None:
+            return
+        self.camera.frame(*found)
+        self.options.grid_scale = grid_scale_for(*found)
         self._framed_once = True
         self._grid_pending = False
         self._camera_moved()
@@ -119,7 +143,7 @@ class CameraNavigation(ViewPart):
 
     def frame_all(self) -> None:
         items = self._items or self.build_items()
-        bounds = scene_bounds(items)
+        bounds = framable(scene_bounds(items))
         if bounds is not None:
             self.camera.frame(*bounds)
             self.options.grid_scale = grid_scale_for(*bounds)
@@ -131,7 +155,7 @@ class CameraNavigation(ViewPart):
         asset, joint = self.ctx.selection
         items = self._items or self.build_items()
         chosen = [i for i in items if getattr(i, "asset_id", None) == asset] if asset else []
-        bounds = scene_bounds(chosen or items)
+        bounds = framable(scene_bounds(chosen or items))
         if bounds is not None:
             self.camera.frame(*bounds)
             if joint:

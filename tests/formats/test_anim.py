@@ -115,7 +115,10 @@ value = st.floats(-1e6, 1e6, allow_nan=False, allow_infinity=False)
 def clips(draw):
     channels = []
     for _ in range(draw(st.integers(0, 4))):
-        times = sorted(set(draw(st.lists(st.floats(-100, 100, allow_nan=False), max_size=6))))
+        times = []  # keys at least 1e-6 s apart, as a file must hold them (docs/formats.md)
+        for t in sorted(set(draw(st.lists(st.floats(-100, 100, allow_nan=False), max_size=6)))):
+            if not times or t - times[-1] >= 1e-6:
+                times.append(t)
         keys = [Key.make(t, draw(value), draw(tangent), draw(tangent)) for t in times]
         ext = st.sampled_from([e.value for e in Extrapolation])
         channels.append(Channel(keys, draw(ext), draw(ext)))

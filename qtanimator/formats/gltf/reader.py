@@ -11,6 +11,7 @@ from typing import Any
 
 import numpy as np
 
+from qtanimator.core.keys import KEY_TIME_TOLERANCE, MAX_KEY_TIME, MAX_KEY_VALUE
 from qtanimator.core.rotation import normalize as _normalize
 from qtanimator.formats._tokens import read_bytes
 from qtanimator.formats.errors import FormatError
@@ -304,6 +305,18 @@ def _triangles(indices: IntArray, mode: int) -> IntArray:
     return np.zeros((0, 3), dtype=np.int64)
 
 
+def _check_times(r: Reader, times: FloatArray, where: str) -> None:
+    """Key times a channel can hold (the glTF spec: strictly increasing; qtanimator's bounds:
+    within ±:data:`MAX_KEY_TIME` seconds and :data:`KEY_TIME_TOLERANCE` apart), else FormatError."""
+    if times.size and not float(np.max(np.abs(times))) <= MAX_KEY_TIME:
+        raise r.error(f"{where}.input holds a time beyond the limit of ±{MAX_KEY_TIME:g} seconds.")
+    gaps = np.diff(times)
+    if gaps.size and float(np.min(gaps)) < KEY_TIME_TOLERANCE:
+        i = int(np.argmin(gaps))
+        raise r.error(f"{where}.input times must increase by at least {KEY_TIME_TOLERANCE:g} s; keys {i} and "
+                      f"{i + 1} are at {float(times[i]):g} and {float(times[i + 1]):g} s.")
+
+
 def _read_animation(r: Reader, ai: int, anim: dict[str, Any], num_nodes: int) -> GltfAnimation:
     w = f"animations[{ai}]"
     samplers = []
@@ -317,10 +330,11 @@ def _read_animation(r: Reader, ai: int, anim: dict[str, Any], num_nodes: int) ->
         if times.dtype.kind != "f" or times.shape[1] != 1:
             raise r.error(f"{sw}.input must be a SCALAR float accessor.")
         times = times.reshape(-1).astype(np.float64)
-        if np.any(np.diff(times) < 0):
-            raise r.error(f"{sw}.input times must increase.")
+        _check_times(r, times, sw)
         values = r.accessor(r.integer(s, "output", sw, required=True) or 0, f"{sw}.output")
         values = np.asarray(values, dtype=np.float64)
+        if values.size and float(np.max(np.abs(values))) > MAX_KEY_VALUE:
+            raise r.error(f"{sw}.output holds a value beyond the limit of ±{MAX_KEY_VALUE:g}.")
         per_key = 3 if interp == "CUBICSPLINE" else 1
         if len(values) % (len(times) * per_key):
             raise r.error(f"{sw} has {len(times)} key times but {len(values)} output values.")

@@ -24,6 +24,10 @@ from qtanimator.ui.curves.items import ChannelDrawing, CurveLayer, HoverLayer, H
 from qtanimator.ui.curves.normalisation import NormalisationCache, unit_scale
 from qtanimator.ui.curves.plot import CurvePlot, CurveViewBox, FrameLine, PlotOwner
 
+#: The largest frame or displayed value the view frames (a project's keys lie far inside:
+#: 1e6 s × 10000 fps, 1e9 × 57.3 for degrees; see docs/formats.md).
+MAX_VIEW_COORDINATE = 1e12
+
 
 class CurveCanvas(QObject):
     """Plot widget, layers and drawings of the curve view (see :class:`~.view.CurveView`)."""
@@ -267,14 +271,20 @@ class CurveCanvas(QObject):
             else:
                 xs += [float(times[i] * fps) for i in idx]
                 ys += [float((values[i] - off) * scale) for i in idx]
-        if not xs:
+        xs = [x for x in xs if math.isfinite(x)]
+        ys = [y for y in ys if math.isfinite(y)]
+        if not xs or not ys:
             return None
         return min(xs), max(xs), min(ys), max(ys)
 
     def _frame_bounds(self, b: tuple[float, float, float, float] | None) -> None:
-        if b is None:
-            start, end = self.doc.frame_range
-            b = (float(start), float(end), -1.0, 1.0)
+        """Show ``b`` = (x0, x1, y0, y1), or the frame range when it is None. pyqtgraph
+        raises for a non-finite range and draws NaN geometry that can crash its paint
+        (issue 31), so a bound that is not finite or too far out gives the default."""
+        start, end = self.doc.frame_range
+        default = (float(start), float(end), -1.0, 1.0)
+        if b is None or not all(math.isfinite(v) and abs(v) <= MAX_VIEW_COORDINATE for v in b):
+            b = default
         x0, x1, y0, y1 = b
         if x1 - x0 < 1e-9:
             x0, x1 = x0 - 10.0, x1 + 10.0

@@ -145,6 +145,7 @@ class ChannelDrawing:
         self._exact: QPainterPath | None = None
         self._reduced: dict[tuple[int, int], QPainterPath] = {}
         self._ext: tuple[Any, float, float, QPainterPath] | None = None
+        self._drawable: bool | None = None
 
     def set_channel(self, channel: Channel, fps: float) -> bool:
         """Show another version of the channel; False when it is the same object."""
@@ -156,6 +157,7 @@ class ChannelDrawing:
         self._exact = None
         self._reduced.clear()
         self._ext = None
+        self._drawable = None
         return True
 
     @property
@@ -184,9 +186,28 @@ class ChannelDrawing:
         px_per_value = max(abs(tr.m22()), 1e-300)
         return round(math.log2(COLUMN_PIXELS / px_per_frame)), round(-math.log2(px_per_value))
 
+    @property
+    def drawable(self) -> bool:
+        """Whether every number the paths are built from is finite. A channel a project's
+        bounds allow always is; one that is not (keys 5e-324 s apart: slopes overflow) is
+        not drawn at all, since Qt can crash painting NaN geometry (issue 31)."""
+        found = self._drawable
+        if found is None:
+            sp = self.spans
+            arrays = (sp.frames, sp.values, sp.v0, sp.v1, sp.bend, sp.c1x, sp.c1y, sp.c2x, sp.c2y)
+            with np.errstate(all="ignore"):
+                found = all(a is None or bool(np.isfinite(a).all()) for a in arrays)
+                if found and len(self.channel.keys) > 1:
+                    found = bool(np.isfinite(self.channel.slopes()).all())
+            self._drawable = found
+        return found
+
     def paths(self, tr: QTransform, x0: float, x1: float) -> tuple[QPainterPath, QPainterPath]:
         """The keyed path and the extrapolation over frames ``[x0, x1]`` (view coordinates
-        before the display transform) for the full transform ``tr`` (data → pixels)."""
+        before the display transform) for the full transform ``tr`` (data → pixels); empty
+        paths for a channel that is not :attr:`drawable` or a range that is not finite."""
+        if not (self.drawable and math.isfinite(x0) and math.isfinite(x1)):
+            return QPainterPath(), QPainterPath()
         level = self.level(tr)
         keyed = self._keyed(level)
         column_level = round(math.log2(COLUMN_PIXELS / max(abs(tr.m11()), 1e-300)))

@@ -42,10 +42,14 @@ def channel_normalisation(channel: Channel) -> tuple[float, float]:
         v = channel.evaluate(t)
     else:
         v = channel.values
+    v = np.asarray(v, dtype=np.float64)
+    v = v[np.isfinite(v)]  # a channel the reader's bounds did not make (or an overflow): never NaN
+    if not v.size:
+        return 0.0, 1.0
     lo, hi = float(np.min(v)), float(np.max(v))
-    half = 0.5 * (hi - lo)
-    mid = 0.5 * (hi + lo)
-    if half <= 1e-12 * max(1.0, abs(mid)):
+    half = 0.5 * hi - 0.5 * lo  # halves first: hi - lo of ±1e308 would overflow
+    mid = 0.5 * hi + 0.5 * lo
+    if not half > 1e-12 * max(1.0, abs(mid)) or not np.isfinite(1.0 / half):
         return mid, 1.0
     return mid, 1.0 / half
 
