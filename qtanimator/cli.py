@@ -87,8 +87,18 @@ def _fail(message: str) -> None:
 
 
 def _render(args: list[str]) -> int:
+    from qtanimator.render.interrupt import RenderInterrupted, report_interrupted, signals_held
+
     try:
-        from qtanimator.render.cli_render import render_main
+        # SIGINT / SIGTERM wait while the renderer and Qt's bindings load (a KeyboardInterrupt
+        # while PySide6 initialises aborts Python), then stop the render with its usual message.
+        with signals_held():
+            import PySide6.QtCore
+            import PySide6.QtGui  # noqa: F401
+
+            from qtanimator.render.cli_render import render_main
+    except RenderInterrupted as exc:
+        return report_interrupted(exc)
     except ImportError as exc:
         if (exc.name or "").startswith("qtanimator.render") or (exc.name or "") in ("PySide6", "OpenGL"):
             _fail(f"rendering is not available in this installation ({exc}).")

@@ -184,18 +184,13 @@ def render_main(argv: Sequence[str]) -> int:
     SIGTERM / SIGINT end the render cleanly (temporary files removed, an existing GIF or
     video left as it was, the private Xvfb stopped at exit) with status 128 + signal.
     """
-    from qtanimator.render.interrupt import RenderInterrupted, interrupt_on_signals, signals_held
+    from qtanimator.render.interrupt import RenderInterrupted, interrupt_on_signals, report_interrupted
 
     try:
         with interrupt_on_signals():
-            with signals_held():  # Qt's bindings initialise: a signal now would abort Python
-                import PySide6.QtCore
-                import PySide6.QtGui  # noqa: F401
             return _render_main(argv)
     except RenderInterrupted as exc:
-        print(f"qtanimator render: stopped by {exc.name}; a GIF or video output was not written "
-              "(an existing file is left as it was)", file=sys.stderr)
-        return exc.exit_status
+        return report_interrupted(exc)
 
 
 def _render_main(argv: Sequence[str]) -> int:

@@ -11,6 +11,7 @@ normally, which stops the Xvfb. Imports no Qt.
 from __future__ import annotations
 
 import signal
+import sys
 import threading
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -94,3 +95,10 @@ def signals_held() -> Iterator[None]:
 def _restore(previous: dict[signal.Signals, Any]) -> None:
     for s, old in previous.items():
         signal.signal(s, old if old is not None else signal.SIG_DFL)
+
+
+def report_interrupted(exc: RenderInterrupted) -> int:
+    """Say that the render was stopped (on stderr) and return its exit status."""
+    print(f"qtanimator render: stopped by {exc.name}; a GIF or video output was not written "
+          "(an existing file is left as it was)", file=sys.stderr)
+    return exc.exit_status

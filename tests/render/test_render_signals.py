@@ -153,6 +153,41 @@ def test_interrupt_on_signals_raises_once_and_restores_handlers():
     assert signal.getsignal(signal.SIGTERM) == before
 
 
+def _maps(pid: int) -> str:
+    try:
+        return Path(f"/proc/{pid}/maps").read_text(errors="replace")
+    except OSError:
+        return ""
+
+
+@pytest.mark.skipif(not Path("/proc/self/maps").exists(), reason="needs /proc")
+def test_a_signal_while_the_render_starts_stops_it_with_its_message(tmp_path):
+    """Ctrl+C while `qtanimator render` is still loading Qt's bindings: the same message and
+    status as later, the old output untouched (it aborted Python inside PySide6's
+    initialisation, or exited 130 without a word)."""
+    out = tmp_path / "out.gif"
+    out.write_bytes(OLD)
+    env = {**os.environ, "QT_QPA_PLATFORM": "offscreen"}
+    env.pop("WAYLAND_DISPLAY", None)
+    proc = subprocess.Popen([sys.executable, "-m", "qtanimator", "render", str(SCENES / "demo/demo.qtanim"),
+                             "-o", str(out), "--frames", "0:5000", "--size", "160x120"], cwd=tmp_path, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    try:
+        deadline = time.monotonic() + 60
+        while time.monotonic() < deadline and "shiboken6" not in _maps(proc.pid) and proc.poll() is None:
+            time.sleep(0.002)
+        proc.send_signal(signal.SIGINT)  # PySide6 is loading (or just loaded)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+    text = err.decode(errors="replace")
+    assert proc.returncode == 130, text
+    assert "stopped by SIGINT" in text and "Fatal Python error" not in text, text
+    assert out.read_bytes() == OLD
+
+
 def test_signals_held_during_a_native_import_raise_when_it_ends():
     """A signal while PySide6 initialises is held (a KeyboardInterrupt there aborts Python),
     then ends the render as usual."""
