@@ -46,22 +46,32 @@ def interrupt_on_signals() -> Iterator[None]:
     Only the first signal raises; later ones are ignored so they cannot break the cleanup
     that the first one started. The previous handlers come back afterwards. Outside the
     main thread (where Python cannot set handlers) the block runs unchanged.
+
+    The exception is raised wherever the main thread is, which may be inside a call into Qt:
+    PySide6 6.8 then reports another error (``SystemError: ... bad argument to internal
+    function``) with the RenderInterrupted lost. Whatever leaves the block after a signal
+    fired is therefore turned back into :class:`RenderInterrupted` for that signal.
     """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    fired = False
+    fired: list[int] = []
 
     def handler(signum: int, frame: FrameType | None) -> None:
-        nonlocal fired
         if fired:
             return
-        fired = True
+        fired.append(signum)
         raise RenderInterrupted(signum)
 
     previous = {s: signal.signal(s, handler) for s in HANDLED}
     try:
         yield
+    except RenderInterrupted:
+        raise
+    except Exception as exc:
+        if fired:
+            raise RenderInterrupted(fired[0]) from exc
+        raise
     finally:
         _restore(previous)
 

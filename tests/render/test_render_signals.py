@@ -188,6 +188,21 @@ def test_a_signal_while_the_render_starts_stops_it_with_its_message(tmp_path):
     assert out.read_bytes() == OLD
 
 
+def test_an_error_that_a_signal_caused_inside_native_code_is_a_stop():
+    """A signal raised inside a C extension's call can come out as another error (PySide6 6.8:
+    SystemError, the RenderInterrupted lost); after a signal, any error ends as the stop."""
+    with pytest.raises(RenderInterrupted) as info, interrupt_on_signals():
+        try:
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(1)
+        except RenderInterrupted:
+            pass  # what a C extension does: swallow it and fail in its own way
+        raise SystemError("bad argument to internal function")
+    assert info.value.signum == signal.SIGTERM and isinstance(info.value.__cause__, SystemError)
+    with pytest.raises(ValueError), interrupt_on_signals():  # no signal: errors stay themselves
+        raise ValueError("no signal here")
+
+
 def test_signals_held_during_a_native_import_raise_when_it_ends():
     """A signal while PySide6 initialises is held (a KeyboardInterrupt there aborts Python),
     then ends the render as usual."""
